@@ -1,0 +1,32 @@
+// Loaders: scene JSON, mesh files (OBJ, PLY, OFF, STL), glTF 2.0, views files.
+// Expected failures return false with a message naming the file, the place and a fix (STYLE 9, 10).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "analysis/scene.h"
+
+namespace va {
+
+struct LoadOptions {
+    ChunkSettings chunks;
+};
+
+// Loads any supported input: *.json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb.
+bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err);
+
+// Reads a mesh file keeping every face (OpenMesh's readers, our own importer: no half-edge mesh).
+bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err);
+
+// Reads a glTF 2.0 file: nodes become objects (world transforms applied), cameras become views,
+// doubleSided and alpha-blend materials become flags.
+bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err);
+
+// Reads a views file: { "views": [ ... ] } with DESIGN.md's view keys.
+bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::string *err);
+
+// N cameras around the scene's bounds looking at its center (deterministic).
+std::vector<ViewSpec> orbitViews(const Scene &scene, int n);
+
+}  // namespace va

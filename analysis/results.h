@@ -1,0 +1,67 @@
+// Result structs of an analysis: what each stage did, per view. reports/ reads these and never runs
+// a stage. Every field says what it counts and its best value; the JSON schema and the README use
+// the same words (docs/report-schema.json, README "What the numbers mean").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "analysis/scene.h"
+#include "render/clip.h"
+#include "render/raster.h"
+
+namespace va {
+
+// One row of the stage funnel.
+struct StageRecord {
+    std::string name;          // cells, grid, frustum, occlusion, backface, clip, zbuffer, raycast
+    bool ran = false;
+    std::string reason;        // why it did not run (empty when it ran)
+    uint64_t trianglesIn = 0;  // triangles entering the stage
+    uint64_t trianglesCulled = 0;
+    uint64_t trianglesOut = 0; // triangles leaving it (clip: screen triangles after fan triangulation)
+    double ms = 0;             // wall time of the stage for this view
+};
+
+struct FrustumStats {
+    uint64_t objectsIn = 0;           // culling objects entering the stage
+    uint64_t objectsCulled = 0;       // bounding sphere entirely outside a plane
+    uint64_t objectsInside = 0;       // bounding sphere entirely inside all six planes
+    uint64_t objectsIntersecting = 0; // kept, touching or crossing a plane
+    uint64_t nodesVisited = 0;        // BVH nodes whose bounding sphere was tested
+    uint64_t planeTests = 0;          // sphere-plane dot products done (BVH walk)
+    uint64_t planeTestsBruteForce = 0;// 6 x objects: what testing every object would cost; best: planeTests << this
+};
+
+struct BackfaceStats {
+    uint64_t trianglesTested = 0;     // triangles whose plane was evaluated at the eye
+    uint64_t trianglesCulled = 0;     // plane <= 0 at the eye: facing away (or edge-on)
+    uint64_t doubleSidedExempt = 0;   // triangles of double-sided materials, never culled
+    uint64_t edgeOn = 0;              // plane exactly 0 at the eye (counted among culled)
+};
+
+struct ViewResult {
+    ViewSpec spec;
+    Camera camera;
+    std::vector<StageRecord> stages;  // in DESIGN.md's fixed order
+    FrustumStats frustum;
+    BackfaceStats backface;
+    ClipStats clip;
+    ZBufferStats zbuffer;
+    ZBuffer buffer;                   // per-pixel buffers, for the images (may be released after writing)
+    double totalMs = 0;
+};
+
+struct AnalysisResult {
+    std::string scenePath;
+    SceneStats sceneStats;
+    uint64_t triangles = 0;           // triangles analysed (source triangles minus excluded)
+    uint64_t objects = 0;             // culling objects
+    uint64_t sourceObjects = 0;
+    Aabb bounds;
+    double loadMs = 0;
+    std::vector<ViewResult> views;
+};
+
+}  // namespace va

@@ -1,0 +1,11 @@
+// The command-line front end: one table of subcommands (ninja's kTools[]).
+#pragma once
+
+namespace va {
+
+// Exit codes (DESIGN.md, Errors).
+enum ExitCode { kExitOk = 0, kExitBudgetFailed = 1, kExitBadInput = 2, kExitInternal = 3 };
+
+int runCli(int argc, char **argv);
+
+}  // namespace va

@@ -1,0 +1,78 @@
+// The z-buffer rasterizer (DESIGN.md: Raster, Depth). Plain data in, plain data out.
+//
+// Coverage: vertices in fixed point with kSubpixelBits fractional bits; edge functions in 64-bit
+// integers; a pixel is covered when its center (x + 0.5, y + 0.5) is inside the triangle, with the
+// top-left fill rule deciding samples exactly on an edge, so two triangles sharing an edge never
+// both cover a pixel and a closed mesh has no cracks. Both windings are drawn (culling is the
+// backface stage's job); triangles whose snapped area is zero draw nothing.
+// Depth: per covered pixel the fragment's view depth is computed in double from the triangle's
+// DepthPlane at the pixel center (viewDepthAt), encoded in the view's depth format, and tested with
+// LESS on the format's ordering key: on equal stored values the first drawn fragment wins.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "render/camera.h"
+#include "render/depth_format.h"
+
+namespace va {
+
+constexpr int kSubpixelBits = 8;
+constexpr int32_t kSubpixelOne = 1 << kSubpixelBits;
+
+// Screen-space triangles ready to rasterize (the clip stage's output), in submission order.
+struct ScreenTriangles {
+    std::vector<int32_t> xy;          // 6 per triangle: x0 y0 x1 y1 x2 y2, pixel units * 2^kSubpixelBits
+    std::vector<uint32_t> source;     // per triangle: the scene's global source triangle index
+    std::vector<uint32_t> plane;      // per triangle: index into planes (pieces of one source share one)
+    std::vector<DepthPlane> planes;   // depth planes, one per source triangle that produced output
+
+    size_t size() const { return source.size(); }
+    void clear() { xy.clear(); source.clear(); plane.clear(); planes.clear(); }
+};
+
+// Converts pixel coordinates to the rasterizer's fixed point (round to nearest, ties to even).
+int32_t toFixed(double pixelCoordinate);
+
+struct ZBufferSettings {
+    DepthEncoder encoder;       // the view's depth format bound to its near/far
+    bool orthographic = false;  // how DepthPlane values turn into view depth
+};
+
+// Per-pixel buffers, row-major, pixel (0,0) top-left.
+struct ZBuffer {
+    int width = 0, height = 0;
+    std::vector<uint32_t> key;        // ordering key of the stored depth; UINT32_MAX = cleared
+    std::vector<uint32_t> id;         // 1 + source triangle index of the visible fragment; 0 = background
+    std::vector<double> depth;        // view depth (double) of the visible fragment; +inf = background
+    std::vector<uint16_t> fragments;  // fragments rasterized at the pixel (depth complexity), saturating
+    std::vector<uint16_t> passes;     // fragments that passed the depth test (overdraw), saturating
+};
+
+struct ZBufferStats {
+    uint64_t trianglesIn = 0;         // triangles submitted
+    uint64_t trianglesDrawn = 0;      // triangles that produced at least one fragment
+    uint64_t trianglesEmpty = 0;      // triangles that cover no pixel center (zero area or tiny); best 0
+    uint64_t fragments = 0;           // pixel centers covered, summed over triangles
+    uint64_t depthPasses = 0;         // fragments that passed the depth test and were written
+    uint64_t outOfRangeFragments = 0; // fragments whose depth the format cannot represent (clamped)
+    uint64_t coveredPixels = 0;       // pixels with at least one fragment
+    double overdraw = 0;              // depthPasses / coveredPixels; best case 1.0
+    double depthComplexity = 0;       // fragments / coveredPixels; best case 1.0
+    uint32_t maxDepthComplexity = 0;  // most fragments at one pixel
+    std::vector<uint64_t> histogram;  // histogram[k] = pixels with exactly k fragments (k >= 1; [0] = uncovered)
+};
+
+struct ZBufferResult {
+    ZBuffer buffer;
+    ZBufferStats stats;
+};
+
+// Rasterizes every triangle in submission order into a cleared width x height buffer.
+ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings);
+
+// Fills the stats that follow from the per-pixel counts (covered pixels, ratios, histogram).
+void finishZBufferStats(const ZBuffer &zb, ZBufferStats *stats);
+
+}  // namespace va
