@@ -1,12 +1,245 @@
+// Subcommands: one table (ninja's kTools[]); --help and the README's command list come from it.
 #include "cli/commands.h"
 
+#include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include "analysis/demo.h"
+#include "analysis/load.h"
+#include "analysis/pipeline.h"
+#include "reports/console.h"
+#include "reports/report.h"
 
 namespace va {
 
+namespace {
+
+struct Options {
+    std::string scene;          // empty: the built-in demo
+    std::string views;          // views file, "orbit:N", or empty (the scene's own)
+    std::string out = "visaudit-report";
+    std::string depthFormat;
+    int width = 0, height = 0;
+    int threads = 0;
+    int maxResolution = 16384;
+    uint32_t chunk = 512;
+    bool noBackface = false, noFrustum = false;
+    bool quiet = false;
+};
+
+void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
+
+// Loads the scene (or makes the demo) and its views as the options say.
+bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
+    std::string err;
+    if (o.scene.empty()) {
+        *scene = demoScene();
+    } else {
+        LoadOptions lo;
+        lo.chunks.maxTriangles = o.chunk;
+        if (!loadScene(o.scene, lo, scene, &err)) {
+            fail(err);
+            return false;
+        }
+    }
+    if (o.views.empty()) {
+        *views = scene->views;
+    } else if (o.views.rfind("orbit:", 0) == 0) {
+        const std::string n = o.views.substr(6);
+        char *end = nullptr;
+        const long k = std::strtol(n.c_str(), &end, 10);
+        if (n.empty() || *end || k < 1 || k > 100000) {
+            fail("--views " + o.views + ": expected orbit:N with N a whole number from 1 to 100000, e.g. orbit:8");
+            return false;
+        }
+        *views = orbitViews(*scene, int(k));
+    } else if (!loadViewsFile(o.views, views, &err)) {
+        fail(err);
+        return false;
+    }
+    if (views->empty()) {
+        *views = orbitViews(*scene, 4);
+        std::fprintf(stderr, "visaudit: %s has no views; using --views orbit:4\n",
+                     o.scene.empty() ? "the demo" : o.scene.c_str());
+    }
+    return true;
+}
+
+bool makeSettings(const Options &o, PipelineSettings *s) {
+    s->frustum = !o.noFrustum;
+    s->backface = !o.noBackface;
+    s->width = o.width;
+    s->height = o.height;
+    s->threads = o.threads;
+    s->limits.maxResolution = o.maxResolution;
+    if (!o.depthFormat.empty()) {
+        DepthFormat f;
+        std::string err;
+        if (!parseDepthFormat(o.depthFormat, &f, &err)) {
+            fail("--depth-format: " + err);
+            return false;
+        }
+        s->depthFormat = f;
+    }
+    return true;
+}
+
+int cmdInfo(const Options &o) {
+    Scene scene;
+    std::vector<ViewSpec> views;
+    if (!loadInputs(o, &scene, &views)) return kExitBadInput;
+    std::printf("scene       %s\n", scene.path.c_str());
+    std::printf("triangles   %llu analysed of %llu in the source (%llu degenerate, %llu non-finite excluded)\n",
+                (unsigned long long)scene.objectTriangles.size(), (unsigned long long)scene.stats.sourceTriangles,
+                (unsigned long long)scene.stats.degenerateTriangles, (unsigned long long)scene.stats.nonFiniteTriangles);
+    std::printf("faces       %llu dropped by the loaders, %llu polygons triangulated\n",
+                (unsigned long long)scene.stats.facesDropped, (unsigned long long)scene.stats.polygonsTriangulated);
+    std::printf("objects     %zu in the scene, %zu culling objects after chunking\n", scene.sources.size(),
+                scene.objects.size());
+    if (scene.bounds.empty())
+        std::printf("bounds      (empty)\n");
+    else
+        std::printf("bounds      [%g, %g, %g] .. [%g, %g, %g]\n", scene.bounds.lo.x, scene.bounds.lo.y,
+                    scene.bounds.lo.z, scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z);
+    std::printf("up axis     %c\n", scene.up);
+    std::printf("materials   %zu\n", scene.materials.size());
+    for (const Material &m : scene.materials)
+        std::printf("  %-16s%s%s%s%s\n", m.name.c_str(), m.doubleSided ? " double-sided" : "",
+                    m.transparent() ? " transparent" : "", m.reflective > 0 ? " reflective" : "",
+                    m.refractive() ? " refractive" : "");
+    std::printf("lights      %zu\n", scene.lights.size());
+    std::printf("views       %zu\n", views.size());
+    for (const ViewSpec &v : views)
+        std::printf("  %-16s%dx%d %s eye [%g, %g, %g] %s\n", v.name.c_str(), v.camera.width, v.camera.height,
+                    v.camera.orthographic ? "ortho" : "persp", v.camera.eye.x, v.camera.eye.y, v.camera.eye.z,
+                    depthFormatInfo(v.depthFormat).name);
+    return kExitOk;
+}
+
+int cmdAnalyze(const Options &o) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    PipelineSettings settings;
+    if (!makeSettings(o, &settings)) return kExitBadInput;
+    Scene scene;
+    std::vector<ViewSpec> views;
+    if (!loadInputs(o, &scene, &views)) return kExitBadInput;
+    const double loadMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+
+    std::string err;
+    OutputDir out;
+    if (!out.open(o.out, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    const bool tty = isatty(fileno(stderr));
+    std::atomic<int> done{0};
+    std::mutex printMutex;
+    AnalysisResult result;
+    auto onView = [&](ViewResult &v, std::string *e) {
+        if (!writeViewImages(v, out.staging(), e)) return false;
+        v.buffer = ZBuffer{};  // the images hold it now
+        const int k = ++done;
+        if (!o.quiet) {
+            std::lock_guard<std::mutex> lock(printMutex);
+            std::fprintf(stderr, tty ? "\r[%d/%zu] %s        " : "[%d/%zu] %s\n", k, views.size(), v.spec.name.c_str());
+        }
+        return true;
+    };
+    if (!analyzeScene(scene, views, settings, onView, &result, &err)) {
+        if (tty && !o.quiet) std::fprintf(stderr, "\n");
+        fail(err);
+        return kExitBadInput;
+    }
+    if (tty && !o.quiet) std::fprintf(stderr, "\n");
+    result.loadMs = loadMs;
+    if (!writeFileAtomic(out.staging() + "/report.json", reportJson(result).dump(2) + "\n", &err) ||
+        !out.commit(&err)) {
+        fail(err);
+        return kExitInternal;
+    }
+    if (!o.quiet) {
+        for (const ViewResult &v : result.views) std::printf("%s\n", funnelTable(v).c_str());
+        std::printf("report: %s/report.json\n", o.out.c_str());
+    }
+    return kExitOk;
+}
+
+void addSceneOptions(CLI::App *c, Options &o) {
+    c->add_option("scene", o.scene, "Scene file: .json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb; "
+                                    "none = the built-in demo");
+    c->add_option("--views", o.views, "Views: a views file (.json), or orbit:N (N cameras around the scene)");
+    c->add_option("--chunk", o.chunk, "Split meshes into culling objects of at most this many triangles")
+        ->check(CLI::Range(1u, 1u << 30));
+}
+
+void addAnalyzeOptions(CLI::App *c, Options &o) {
+    addSceneOptions(c, o);
+    c->add_option("--out", o.out, "Output folder (written as a whole or not at all)");
+    c->add_option("--width", o.width, "Override every view's width in pixels")->check(CLI::Range(1, 1 << 30));
+    c->add_option("--height", o.height, "Override every view's height in pixels")->check(CLI::Range(1, 1 << 30));
+    c->add_option("--depth-format", o.depthFormat, "Override every view's depth format (e.g. f32, unorm24)");
+    c->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
+    c->add_option("--max-resolution", o.maxResolution, "Largest width or height accepted")
+        ->check(CLI::Range(1, 1 << 20));
+    c->add_flag("--no-backface", o.noBackface, "Turn the backface stage off");
+    c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
+    c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
+}
+
+struct Command {
+    const char *name;
+    const char *help;
+    void (*setup)(CLI::App *, Options &);
+    int (*run)(const Options &);
+};
+
+const Command kCommands[] = {
+    {"info", "Summarize a scene: triangles, objects, bounds, materials, views, degenerate faces", addSceneOptions,
+     cmdInfo},
+    {"analyze", "Run every stage for every view; write report.json and images to --out", addAnalyzeOptions,
+     cmdAnalyze},
+};
+
+}  // namespace
+
 int runCli(int argc, char **argv) {
-    std::fprintf(stderr, "visaudit: under construction\n");
-    return kExitInternal;
+    CLI::App app{"visaudit " VISAUDIT_VERSION " - scene-visibility analyzer and report generator"};
+    app.set_version_flag("--version", "visaudit " VISAUDIT_VERSION);
+    app.require_subcommand(1);
+    Options opt;
+    std::vector<std::pair<CLI::App *, const Command *>> subs;
+    for (const Command &c : kCommands) {
+        CLI::App *s = app.add_subcommand(c.name, c.help);
+        c.setup(s, opt);
+        subs.push_back({s, &c});
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError &e) {
+        const int code = app.exit(e);
+        return code == 0 ? kExitOk : kExitBadInput;
+    }
+    try {
+        for (auto &[s, c] : subs)
+            if (s->parsed()) return c->run(opt);
+    } catch (const std::bad_alloc &) {
+        fail("out of memory; lower the resolution or the number of views");
+        return kExitInternal;
+    } catch (const std::exception &e) {
+        fail(std::string("internal error: ") + e.what());
+        return kExitInternal;
+    }
+    return kExitBadInput;
 }
 
 }  // namespace va

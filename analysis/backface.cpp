@@ -1,0 +1,101 @@
+#include "analysis/backface.h"
+
+#include <cmath>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+namespace va {
+
+namespace {
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+// Sign of the triangle's plane at point e, exactly: +1 when e is on the side from which
+// (v0, v1, v2) appear counter-clockwise (the front), -1 behind, 0 on the plane.
+int exactSide(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 e) {
+    const CGAL::Orientation o = CGAL::orientation(Kernel::Point_3(v0.x, v0.y, v0.z), Kernel::Point_3(v1.x, v1.y, v1.z),
+                                                  Kernel::Point_3(v2.x, v2.y, v2.z), Kernel::Point_3(e.x, e.y, e.z));
+    // CGAL: POSITIVE when det[v1 - v0, v2 - v0, e - v0] > 0, i.e. when v0, v1, v2 appear
+    // counter-clockwise seen from e (checked: (0,0,0), (1,0,0), (0,1,0) from (0,0,1) is POSITIVE).
+    return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+}
+}  // namespace
+
+bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edgeOn) {
+    const double *p = &scene.planes[4 * size_t(t)];
+    const Vec3 n{p[0], p[1], p[2]};
+    if (edgeOn) *edgeOn = false;
+    if (cam.orthographic) {
+        // Front when the normal points against the view direction: n . (-forward) > 0. Where the
+        // sign is within the rounding of the dot product, keep the triangle (conservative).
+        const double s = -dot(n, cam.forward);
+        const double err = gamma(4) * (std::fabs(n.x * cam.forward.x) + std::fabs(n.y * cam.forward.y) +
+                                       std::fabs(n.z * cam.forward.z));
+        if (s == 0 && edgeOn) *edgeOn = true;
+        return s > -err;
+    }
+    // Filter: n.e + k in double, with a bound on its rounding error that covers the computation
+    // of n and k from the vertices too (pbrt-style gamma bound, generous factor).
+    const Vec3 &e = cam.eye;
+    const double s = dot(n, e) + p[3];
+    const uint32_t *ix = &scene.indices[3 * size_t(t)];
+    const Vec3 v0 = scene.positions[ix[0]], v1 = scene.positions[ix[1]], v2 = scene.positions[ix[2]];
+    const double mag = (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z)) *
+                       (maxAbs(e) + std::fmax(maxAbs(v0), std::fmax(maxAbs(v1), maxAbs(v2))));
+    const double err = gamma(12) * mag;
+    if (s > err) return true;
+    if (s < -err) return false;
+    const int side = exactSide(v0, v1, v2, e);
+    if (side == 0 && edgeOn) *edgeOn = true;
+    return side > 0;
+}
+
+TriangleLists allTriangles(const Scene &scene, const std::vector<uint32_t> &objects) {
+    TriangleLists l;
+    l.objects = objects;
+    l.groupBegin.reserve(objects.size() + 1);
+    for (uint32_t o : objects) {
+        l.groupBegin.push_back(uint32_t(l.triangles.size()));
+        const SceneObject &ob = scene.objects[o];
+        l.triangles.insert(l.triangles.end(), scene.objectTriangles.begin() + ob.triBegin,
+                           scene.objectTriangles.begin() + ob.triEnd);
+    }
+    l.groupBegin.push_back(uint32_t(l.triangles.size()));
+    return l;
+}
+
+BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &objects, const Camera &cam) {
+    BackfaceResult r;
+    TriangleLists &l = r.kept;
+    BackfaceStats &st = r.stats;
+    l.objects.reserve(objects.size());
+    for (uint32_t o : objects) {
+        const SceneObject &ob = scene.objects[o];
+        const uint32_t begin = uint32_t(l.triangles.size());
+        const uint32_t n = ob.triEnd - ob.triBegin;
+        if (scene.materialOf(ob).doubleSided) {
+            st.doubleSidedExempt += n;
+            l.triangles.insert(l.triangles.end(), scene.objectTriangles.begin() + ob.triBegin,
+                               scene.objectTriangles.begin() + ob.triEnd);
+        } else {
+            st.trianglesTested += n;
+            for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) {
+                const uint32_t t = scene.objectTriangles[i];
+                bool edgeOn = false;
+                if (isFrontFacing(scene, t, cam, &edgeOn)) {
+                    l.triangles.push_back(t);
+                } else {
+                    ++st.trianglesCulled;
+                    st.edgeOn += edgeOn;
+                }
+            }
+        }
+        if (l.triangles.size() > begin) {  // objects with every triangle culled leave no group
+            l.objects.push_back(o);
+            l.groupBegin.push_back(begin);
+        }
+    }
+    l.groupBegin.push_back(uint32_t(l.triangles.size()));
+    return r;
+}
+
+}  // namespace va

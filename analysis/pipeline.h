@@ -1,0 +1,52 @@
+// The pipeline: which stages a view runs, in DESIGN.md's fixed coarse-to-fine order, and the
+// glue that turns the scene model into the plain data render/ works on.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analysis/frustum.h"
+#include "analysis/results.h"
+#include "analysis/scene.h"
+#include "render/clip.h"
+
+namespace va {
+
+// Hard limits that protect the machine from absurd input; refused before allocating.
+struct Limits {
+    int maxResolution = 16384;  // per side
+};
+
+struct PipelineSettings {
+    bool frustum = true;   // --no-frustum turns the stage off
+    bool backface = true;  // --no-backface turns the stage off
+    int width = 0, height = 0;                 // > 0: override every view's resolution
+    std::optional<DepthFormat> depthFormat;    // override every view's depth format
+    ClipSettings clip;
+    Limits limits;
+    int threads = 0;                           // 0: all cores
+};
+
+// View-independent acceleration data, built once per scene.
+struct PreparedScene {
+    const Scene *scene = nullptr;
+    ObjectBvh bvh;
+};
+PreparedScene prepareScene(const Scene &scene);
+
+// The view after settings' overrides, validated; false with a message naming the view and a fix.
+bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, Camera *cam, std::string *err);
+
+// Runs every stage for one (resolved) view.
+ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Camera &cam, const PipelineSettings &s);
+
+// Runs every view (in parallel); `onView` is called once per finished view, from worker threads,
+// and may write images and release the view's buffers. Results keep the views' order.
+// Returns false (with *err) when a view is invalid or onView fails; nothing is half-reported.
+bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const PipelineSettings &s,
+                  const std::function<bool(ViewResult &, std::string *)> &onView, AnalysisResult *out,
+                  std::string *err);
+
+}  // namespace va

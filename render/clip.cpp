@@ -1,0 +1,223 @@
+#include "render/clip.h"
+
+#include <cmath>
+
+namespace va {
+
+const char *const kClipPlaneNames[kClipPlaneCount] = {"near", "far", "left", "right", "bottom", "top"};
+
+namespace {
+
+// A vertex in the clipper's space: clip-space x, y, w and the view depth d. All four are linear
+// (perspective: w = d) or affine (orthographic: w = 1) functions of the view-space position, so
+// linear interpolation between two vertices is exactly interpolation of the view-space segment,
+// and every clip plane below is a linear function of (x, y, w, d).
+struct ClipVertex {
+    double x, y, w, d;
+};
+
+// Outcode bits: the view frustum's planes, then the guard band's side planes.
+enum : uint32_t {
+    kOutNear = 1u << kPlaneNear,
+    kOutFar = 1u << kPlaneFar,
+    kOutLeft = 1u << kPlaneLeft,
+    kOutRight = 1u << kPlaneRight,
+    kOutBottom = 1u << kPlaneBottom,
+    kOutTop = 1u << kPlaneTop,
+    kOutGuardShift = 6,  // guard-band left/right/bottom/top = the side bits shifted by 4
+    kFrustumBits = 0x3F,
+    kSideBits = kOutLeft | kOutRight | kOutBottom | kOutTop,
+};
+constexpr uint32_t guardBit(int plane) { return 1u << (plane + 4); }  // planes 2..5 -> bits 6..9
+constexpr uint32_t kGuardBits = guardBit(kPlaneLeft) | guardBit(kPlaneRight) | guardBit(kPlaneBottom) |
+                                guardBit(kPlaneTop);
+
+struct ClipSpace {
+    double nearZ, farZ, gx, gy;  // gx, gy: guard-band extents in NDC units (>= 1)
+    double halfW, halfH;
+
+    // Signed distance-like value of v to a plane; >= 0 is inside. For the side planes this is the
+    // guard-band plane: the clipper only ever cuts at the guard band, never at the viewport.
+    double dist(const ClipVertex &v, int plane) const {
+        switch (plane) {
+        case kPlaneNear: return v.d - nearZ;
+        case kPlaneFar: return farZ - v.d;
+        case kPlaneLeft: return v.x + gx * v.w;
+        case kPlaneRight: return gx * v.w - v.x;
+        case kPlaneBottom: return v.y + gy * v.w;
+        default: return gy * v.w - v.y;
+        }
+    }
+
+    uint32_t outcode(const ClipVertex &v) const {
+        uint32_t c = 0;
+        if (v.d < nearZ) c |= kOutNear;
+        if (v.d > farZ) c |= kOutFar;
+        if (v.x < -v.w) c |= kOutLeft;
+        if (v.x > v.w) c |= kOutRight;
+        if (v.y < -v.w) c |= kOutBottom;
+        if (v.y > v.w) c |= kOutTop;
+        if (v.x < -gx * v.w) c |= guardBit(kPlaneLeft);
+        if (v.x > gx * v.w) c |= guardBit(kPlaneRight);
+        if (v.y < -gy * v.w) c |= guardBit(kPlaneBottom);
+        if (v.y > gy * v.w) c |= guardBit(kPlaneTop);
+        return c;
+    }
+
+    // Perspective divide and viewport transform to fixed point. Only called for vertices inside
+    // near (w >= n > 0) and inside the guard band, so the result is bounded by the guard band.
+    void project(const ClipVertex &v, int32_t *xy) const {
+        const double inv = 1.0 / v.w;
+        xy[0] = toFixed((v.x * inv + 1.0) * halfW);
+        xy[1] = toFixed((1.0 - v.y * inv) * halfH);
+    }
+};
+
+// Sutherland-Hodgman against one plane. The intersection is always computed from the inside
+// vertex towards the outside one, so the two triangles sharing a clipped edge get bit-identical
+// new vertices, whichever direction each walks the edge: no cracks along clip boundaries.
+int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, ClipVertex *out) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        const ClipVertex &a = in[i];
+        const ClipVertex &b = in[(i + 1) % n];
+        const double da = cs.dist(a, plane), db = cs.dist(b, plane);
+        const bool ina = da >= 0, inb = db >= 0;
+        if (ina) out[m++] = a;
+        if (ina != inb) {
+            const ClipVertex &p = ina ? a : b;  // inside
+            const ClipVertex &q = ina ? b : a;  // outside
+            const double dp = ina ? da : db, dq = ina ? db : da;
+            const double t = dp / (dp - dq);  // in [0, 1]: dp >= 0 > dq
+            out[m++] = {p.x + t * (q.x - p.x), p.y + t * (q.y - p.y), p.w + t * (q.w - p.w),
+                        p.d + t * (q.d - p.d)};
+        }
+    }
+    return m;
+}
+
+}  // namespace
+
+ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vector<ClipBatch> &batches,
+                         const ClipSettings &settings) {
+    ClipResult r;
+    ClipStats &st = r.stats;
+    ScreenTriangles &out = r.out;
+
+    ClipSpace cs;
+    cs.nearZ = cam.nearZ;
+    cs.farZ = cam.farZ;
+    cs.halfW = 0.5 * cam.width;
+    cs.halfH = 0.5 * cam.height;
+    cs.gx = 1 + settings.guardBandPixels / cs.halfW;
+    cs.gy = 1 + settings.guardBandPixels / cs.halfH;
+
+    size_t total = 0;
+    for (const ClipBatch &b : batches) total += b.count;
+    out.xy.reserve(total * 6);
+    out.source.reserve(total);
+    out.plane.reserve(total);
+    out.planes.reserve(total);
+
+    // Per-batch scratch: view-space position, clip vertex, outcode and (when inside the guard band
+    // and in front of near) the projected fixed-point position of every vertex of the batch.
+    std::vector<Vec3> view;
+    std::vector<ClipVertex> cv;
+    std::vector<uint32_t> code;
+    std::vector<int32_t> screen;
+    const Mat4 &vw = cam.viewFromWorld;
+
+    for (const ClipBatch &b : batches) {
+        const uint32_t nv = b.vertexEnd - b.vertexBegin;
+        view.resize(nv);
+        cv.resize(nv);
+        code.resize(nv);
+        screen.resize(size_t(nv) * 2);
+        for (uint32_t i = 0; i < nv; ++i) {
+            const Vec3 v = transformPoint(vw, mesh.positions[b.vertexBegin + i]);
+            view[i] = v;
+            const double d = -v.z;
+            ClipVertex c{cam.sx * v.x, cam.sy * v.y, cam.orthographic ? 1.0 : d, d};
+            cv[i] = c;
+            code[i] = cs.outcode(c);
+            if ((code[i] & (kOutNear | kOutFar | kGuardBits)) == 0) cs.project(c, &screen[size_t(i) * 2]);
+        }
+
+        st.trianglesIn += b.count;
+        for (uint32_t k = 0; k < b.count; ++k) {
+            const uint32_t t = b.triangles[k];
+            const uint32_t i0 = mesh.indices[3 * size_t(t)] - b.vertexBegin;
+            const uint32_t i1 = mesh.indices[3 * size_t(t) + 1] - b.vertexBegin;
+            const uint32_t i2 = mesh.indices[3 * size_t(t) + 2] - b.vertexBegin;
+            const uint32_t c0 = code[i0], c1 = code[i1], c2 = code[i2];
+
+            // Trivial reject: all three vertices outside one plane of the view frustum.
+            if ((c0 & c1 & c2 & kFrustumBits) != 0) {
+                ++st.trivialRejected;
+                continue;
+            }
+            const DepthPlane plane = depthPlaneFromView(cam, view[i0], view[i1], view[i2]);
+            if (!plane.valid) {
+                ++st.edgeOn;
+                continue;
+            }
+            const uint32_t any = c0 | c1 | c2;
+            if ((any & (kOutNear | kOutFar | kGuardBits)) == 0) {
+                // Inside, or crossing a viewport side while staying in the guard band: the
+                // rasterizer's bounding box and edge functions do the 2D clipping.
+                if (any == 0)
+                    ++st.inside;
+                else
+                    ++st.guardBandAccepted;
+                const uint32_t pi = uint32_t(out.planes.size());
+                out.planes.push_back(plane);
+                const int32_t *s0 = &screen[size_t(i0) * 2], *s1 = &screen[size_t(i1) * 2],
+                              *s2 = &screen[size_t(i2) * 2];
+                out.xy.insert(out.xy.end(), {s0[0], s0[1], s1[0], s1[1], s2[0], s2[1]});
+                out.source.push_back(t);
+                out.plane.push_back(pi);
+                ++st.trianglesOut;
+                continue;
+            }
+
+            // Sutherland-Hodgman in homogeneous clip space, before the divide. Near is clipped
+            // first (whenever any vertex is behind it), so nothing behind the eye is projected.
+            ++st.clipped;
+            ClipVertex bufA[16], bufB[16];
+            ClipVertex *src = bufA, *dst = bufB;
+            src[0] = cv[i0];
+            src[1] = cv[i1];
+            src[2] = cv[i2];
+            int n = 3;
+            for (int p = 0; p < kClipPlaneCount && n >= 3; ++p) {
+                const uint32_t bit = p < 2 ? (1u << p) : guardBit(p);
+                if (!(any & bit)) continue;
+                ++st.perPlane[p];
+                n = clipPolygon(cs, p, src, n, dst);  // each plane adds at most one vertex: n <= 9
+                std::swap(src, dst);
+            }
+            if (n < 3) {
+                ++st.clippedAway;
+                continue;
+            }
+            ++st.polygonVertices[n < 9 ? n : 9];
+            const uint32_t pi = uint32_t(out.planes.size());
+            out.planes.push_back(plane);
+            int32_t p0[2], pa[2], pb[2];
+            cs.project(src[0], p0);
+            cs.project(src[1], pb);
+            for (int v = 2; v < n; ++v) {  // fan from the first vertex
+                pa[0] = pb[0];
+                pa[1] = pb[1];
+                cs.project(src[v], pb);
+                out.xy.insert(out.xy.end(), {p0[0], p0[1], pa[0], pa[1], pb[0], pb[1]});
+                out.source.push_back(t);
+                out.plane.push_back(pi);
+                ++st.trianglesOut;
+            }
+        }
+    }
+    return r;
+}
+
+}  // namespace va
