@@ -42,6 +42,7 @@ struct RawMesh {
     uint64_t facesRead = 0;         // faces in the file (polygons count once)
     uint64_t polygonsTriangulated = 0;  // faces with more than 3 vertices
     uint64_t facesDropped = 0;      // faces that could not be used (fewer than 3 valid vertices)
+    std::vector<std::string> warnings;  // what the reader noticed but could read past (never silent)
 };
 
 // An object as the scene file names it (one mesh instance, one material).
@@ -91,6 +92,7 @@ struct Scene {
     std::vector<ViewSpec> views;
     Aabb bounds;
     SceneStats stats;
+    std::vector<std::string> warnings;    // loader notes: dropped faces, ignored glTF features, ...
 
     size_t triangleCount() const { return triangleObject.size(); }
     const Material &materialOf(const SceneObject &o) const { return materials[o.material]; }
@@ -109,10 +111,16 @@ struct SceneBuildInput {
     std::vector<ViewSpec> views;
     char up = 'y';
     std::string path;
+    std::vector<std::string> warnings;  // copied to Scene::warnings (after each mesh's own warnings)
 };
 struct ChunkSettings {
     uint32_t maxTriangles = 512;  // source objects larger than this are split into chunks
 };
+// Fails (false + message) only on input that cannot be represented: more than 2^32 - 1 vertices or
+// triangles after chunking, an index outside its object's positions, a material index out of range.
+bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *out, std::string *err);
+// Convenience for trusted input (tests, generated scenes): throws std::runtime_error where the
+// overload above returns false. Loaders use the overload above.
 Scene buildScene(SceneBuildInput &&in, const ChunkSettings &chunks = {});
 
 }  // namespace va

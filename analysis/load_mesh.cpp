@@ -1,0 +1,430 @@
+// Mesh files (OBJ, PLY, OFF, STL) through OpenMesh's readers, into a RawMesh that keeps every face.
+//
+// OpenMesh's readers talk to the mesh through OpenMesh::IO::BaseImporter. Its stock importer
+// (ImporterT) builds a half-edge mesh, which refuses non-manifold faces (three faces on one edge, a
+// duplicate face, a "complex vertex") and drops them with only a log line. Game levels are full of
+// such faces, so FaceRecorder below implements BaseImporter itself: every vertex and every face is
+// recorded as the reader hands it over, and polygons are fan-triangulated from their first vertex.
+//
+// What the readers themselves do before our importer sees anything (checked against OpenMesh 9.0):
+//   - STL (ascii and binary) merges vertices with bit-identical float coordinates and skips, without
+//     telling the importer, every facet whose three merged vertices are not distinct. We count the
+//     facets in the file ourselves (binary: the header's count; ascii: "outer loop" lines) so those
+//     facets are reported as dropped, never silently lost.
+//   - OBJ resolves negative (relative) indices itself; indices out of range are reported by the
+//     reader on omerr and the face is not handed over; we count faces in the file ourselves to
+//     report the difference as dropped.
+//   - All readers store coordinates as float (Vec3f) except where a PLY declares double properties.
+#include <OpenMesh/Core/IO/IOManager.hh>
+#include <OpenMesh/Core/IO/Options.hh>
+#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <string_view>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include "analysis/load.h"
+
+namespace va {
+namespace {
+
+using OpenMesh::EdgeHandle;
+using OpenMesh::FaceHandle;
+using OpenMesh::HalfedgeHandle;
+using OpenMesh::VertexHandle;
+
+class FaceRecorder final : public OpenMesh::IO::BaseImporter {
+public:
+    explicit FaceRecorder(RawMesh *m) : m_(m) {}
+
+    VertexHandle add_vertex(const OpenMesh::Vec3f &p) override {
+        m_->positions.push_back({double(p[0]), double(p[1]), double(p[2])});
+        return VertexHandle(int(m_->positions.size() - 1));
+    }
+    VertexHandle add_vertex(const OpenMesh::Vec3d &p) override {
+        m_->positions.push_back({p[0], p[1], p[2]});
+        return VertexHandle(int(m_->positions.size() - 1));
+    }
+    VertexHandle add_vertex() override {
+        m_->positions.push_back({0, 0, 0});
+        return VertexHandle(int(m_->positions.size() - 1));
+    }
+    void set_point(VertexHandle vh, const OpenMesh::Vec3f &p) override {
+        if (vh.is_valid() && size_t(vh.idx()) < m_->positions.size())
+            m_->positions[vh.idx()] = {double(p[0]), double(p[1]), double(p[2])};
+    }
+
+    // Every face the reader hands over counts as read. A face is dropped when one of its indices
+    // is invalid, or when it has fewer than 3 distinct vertices; otherwise it becomes a fan
+    // (v0, v[i], v[i+1]) in the given order: a triangle with a repeated corner inside a polygon
+    // stays, as a zero-area triangle that buildScene counts as degenerate.
+    FaceHandle add_face(const VHandles &vs) override {
+        ++m_->facesRead;
+        const FaceHandle fh(int(faces_++));
+        const size_t nv = m_->positions.size();
+        for (const auto &v : vs)
+            if (!v.is_valid() || size_t(v.idx()) >= nv) {
+                ++m_->facesDropped;
+                ++badIndexFaces;
+                return fh;
+            }
+        distinct_.clear();
+        for (const auto &v : vs) distinct_.push_back(v.idx());
+        std::sort(distinct_.begin(), distinct_.end());
+        if (std::unique(distinct_.begin(), distinct_.end()) - distinct_.begin() < 3) {
+            ++m_->facesDropped;
+            ++tooFewFaces;
+            return fh;
+        }
+        if (vs.size() > 3) ++m_->polygonsTriangulated;
+        for (size_t i = 1; i + 1 < vs.size(); ++i) {
+            m_->indices.push_back(uint32_t(vs[0].idx()));
+            m_->indices.push_back(uint32_t(vs[i].idx()));
+            m_->indices.push_back(uint32_t(vs[i + 1].idx()));
+        }
+        return fh;
+    }
+
+    // Half-edge level construction (only OpenMesh's own .om format uses it): not supported.
+    HalfedgeHandle add_edge(VertexHandle, VertexHandle) override { return HalfedgeHandle(); }
+    FaceHandle add_face(HalfedgeHandle) override { return FaceHandle(); }
+
+    // Attributes we do not need: accepted and ignored.
+    void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec2f> &) override {}
+    void add_face_texcoords(FaceHandle, VertexHandle, const std::vector<OpenMesh::Vec3f> &) override {}
+    void set_face_texindex(FaceHandle, int) override {}
+    void set_halfedge(VertexHandle, HalfedgeHandle) override {}
+    void set_normal(VertexHandle, const OpenMesh::Vec3f &) override {}
+    void set_normal(VertexHandle, const OpenMesh::Vec3d &) override {}
+    void set_color(VertexHandle, const OpenMesh::Vec3uc &) override {}
+    void set_color(VertexHandle, const OpenMesh::Vec4uc &) override {}
+    void set_color(VertexHandle, const OpenMesh::Vec3f &) override {}
+    void set_color(VertexHandle, const OpenMesh::Vec4f &) override {}
+    void set_texcoord(VertexHandle, const OpenMesh::Vec2f &) override {}
+    void set_status(VertexHandle, const OpenMesh::Attributes::StatusInfo &) override {}
+    void set_next(HalfedgeHandle, HalfedgeHandle) override {}
+    void set_face(HalfedgeHandle, FaceHandle) override {}
+    void request_face_texcoords2D() override {}
+    void set_texcoord(HalfedgeHandle, const OpenMesh::Vec2f &) override {}
+    void set_texcoord(VertexHandle, const OpenMesh::Vec3f &) override {}
+    void set_texcoord(HalfedgeHandle, const OpenMesh::Vec3f &) override {}
+    void set_status(HalfedgeHandle, const OpenMesh::Attributes::StatusInfo &) override {}
+    void set_color(EdgeHandle, const OpenMesh::Vec3uc &) override {}
+    void set_color(EdgeHandle, const OpenMesh::Vec4uc &) override {}
+    void set_color(EdgeHandle, const OpenMesh::Vec3f &) override {}
+    void set_color(EdgeHandle, const OpenMesh::Vec4f &) override {}
+    void set_status(EdgeHandle, const OpenMesh::Attributes::StatusInfo &) override {}
+    void set_normal(FaceHandle, const OpenMesh::Vec3f &) override {}
+    void set_normal(FaceHandle, const OpenMesh::Vec3d &) override {}
+    void set_color(FaceHandle, const OpenMesh::Vec3uc &) override {}
+    void set_color(FaceHandle, const OpenMesh::Vec4uc &) override {}
+    void set_color(FaceHandle, const OpenMesh::Vec3f &) override {}
+    void set_color(FaceHandle, const OpenMesh::Vec4f &) override {}
+    void set_status(FaceHandle, const OpenMesh::Attributes::StatusInfo &) override {}
+    void add_texture_information(int, std::string) override {}
+
+    void reserve(unsigned int nV, unsigned int, unsigned int nF) override {
+        // Sizes come from file headers: cap the reservation so a lying header cannot exhaust memory.
+        constexpr unsigned int kCap = 1u << 24;
+        m_->positions.reserve(std::min(nV, kCap));
+        m_->indices.reserve(size_t(std::min(nF, kCap)) * 3);
+    }
+    size_t n_vertices() const override { return m_->positions.size(); }
+    size_t n_faces() const override { return faces_; }
+    size_t n_edges() const override { return 0; }
+
+    uint64_t badIndexFaces = 0, tooFewFaces = 0;
+
+private:
+    RawMesh *m_;
+    size_t faces_ = 0;
+    std::vector<int> distinct_;
+};
+
+// OpenMesh's readers are driven through a process-wide IOManager and log to the global streams
+// omerr/omlog/omout. One mutex serializes reads; while it is held the three streams are re-routed
+// from the console into a string, which becomes part of our message when the read fails.
+std::mutex gOpenMeshMutex;
+
+class CaptureOpenMeshLog {
+public:
+    CaptureOpenMeshLog() {
+        for (auto *s : {&omerr(), &omlog(), &omout()}) {
+            s->flush();
+            s->disconnect(std::cerr);
+            s->disconnect(std::clog);
+            s->disconnect(std::cout);
+            s->connect(buf_);
+        }
+    }
+    ~CaptureOpenMeshLog() {
+        omerr().flush(), omlog().flush(), omout().flush();
+        omerr().disconnect(buf_), omlog().disconnect(buf_), omout().disconnect(buf_);
+        // OpenMesh's defaults: omerr -> cerr, omlog -> clog, omout -> cout.
+        omerr().connect(std::cerr);
+        omlog().connect(std::clog);
+        omout().connect(std::cout);
+    }
+    std::string text() {
+        omerr().flush(), omlog().flush(), omout().flush();
+        std::string t = buf_.str();
+        while (!t.empty() && std::isspace((unsigned char)t.back())) t.pop_back();
+        return t;
+    }
+
+private:
+    std::ostringstream buf_;
+};
+
+std::string lowerExtension(const std::string &path) {
+    std::string e = std::filesystem::path(path).extension().string();
+    for (auto &c : e) c = char(std::tolower((unsigned char)c));
+    return e;
+}
+
+// Facets in an STL file, counted independently of OpenMesh (which skips degenerate facets silently).
+// Binary: the 32-bit count after the 80-byte header when the file size matches 84 + 50n, exactly
+// OpenMesh's own test; otherwise ascii: lines whose first word is "outer".
+bool countStlFacets(const std::string &path, uint64_t *n) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return false;
+    f.seekg(0, std::ios::end);
+    const uint64_t size = uint64_t(f.tellg());
+    f.seekg(0);
+    if (size >= 84) {
+        char header[84];
+        f.read(header, 84);
+        uint32_t count;
+        std::memcpy(&count, header + 80, 4);  // little-endian on every platform we build for
+        if (84 + 50 * uint64_t(count) == size) {
+            *n = count;
+            return true;
+        }
+    }
+    f.clear();
+    f.seekg(0);
+    std::string line;
+    uint64_t c = 0;
+    while (std::getline(f, line)) {
+        size_t i = line.find_first_not_of(" \t\r");
+        if (i != std::string::npos && (line.compare(i, 5, "outer") == 0 || line.compare(i, 5, "OUTER") == 0)) ++c;
+    }
+    *n = c;
+    return true;
+}
+
+// Reads a whole file into memory (mesh files are read twice at most: once by OpenMesh, once here).
+bool readAll(const std::string &path, std::string *text) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return false;
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    *text = std::move(ss).str();
+    return true;
+}
+
+// Calls fn(lineNumber, line) for every line (without its end-of-line characters).
+template <class Fn>
+void forEachLine(const std::string &text, Fn fn) {
+    size_t b = 0, line = 1;
+    while (b < text.size()) {
+        size_t e = text.find('\n', b);
+        if (e == std::string::npos) e = text.size();
+        size_t end = e;
+        if (end > b && text[end - 1] == '\r') --end;
+        if (!fn(line, std::string_view(text).substr(b, end - b))) return;
+        b = e + 1;
+        ++line;
+    }
+}
+
+std::string_view firstWord(std::string_view l) {
+    size_t i = l.find_first_not_of(" \t");
+    if (i == std::string_view::npos) return {};
+    size_t j = l.find_first_of(" \t", i);
+    return l.substr(i, (j == std::string_view::npos ? l.size() : j) - i);
+}
+
+// OBJ checks where OpenMesh's reader is silent. Its reader parses a "v" line with iostream and skips
+// the vertex when that fails: "nan", "inf", an overflowing number or fewer than 3 coordinates. The
+// skipped vertex shifts every later index by one, so every later face would silently use the wrong
+// vertices. We count "v" and "f" lines; when the vertex count differs from what the reader stored,
+// the first vertex line whose three coordinates are not finite numbers is named in the error.
+// (A non-finite coordinate therefore cannot come from an OBJ file; the other formats hand NaN over
+// and buildScene counts the triangles as non-finite.)
+bool checkObj(const std::string &path, const std::string &text, size_t positionsRead, uint64_t *faceLines,
+              std::string *err) {
+    uint64_t vLines = 0, fLines = 0;
+    forEachLine(text, [&](size_t, std::string_view l) {
+        const std::string_view w = firstWord(l);
+        if (w == "v") ++vLines;
+        else if (w == "f") ++fLines;
+        return true;
+    });
+    *faceLines = fLines;
+    if (vLines == positionsRead) return true;
+    std::string msg;
+    forEachLine(text, [&](size_t n, std::string_view l) {
+        if (firstWord(l) != "v") return true;
+        std::string line(l);
+        const char *p = line.c_str() + line.find('v') + 1;
+        for (int k = 0; k < 3; ++k) {
+            char *end = nullptr;
+            const double x = std::strtod(p, &end);
+            if (end == p || !std::isfinite(x)) {
+                msg = path + ":" + std::to_string(n) + ": vertex '" + line + "': " +
+                      (end == p ? "expected 3 numbers" : "coordinate is not a finite number") +
+                      "; OpenMesh's OBJ reader skips such a vertex, which would shift every later face "
+                      "index, so the file is refused: write three finite coordinates";
+                return false;
+            }
+            p = end;
+        }
+        return true;
+    });
+    if (msg.empty())
+        msg = path + ": the file has " + std::to_string(vLines) + " vertex lines but OpenMesh's OBJ reader read " +
+              std::to_string(positionsRead) + " vertices; refusing the file (later face indices would be wrong)";
+    *err = msg;
+    return false;
+}
+
+// OFF checks: OpenMesh's OFF reader misreads a counts line without the edge count and comment lines
+// after the header, silently producing garbage. The counts line (after "OFF" and any '#' comment or
+// blank lines) must match what the reader produced.
+bool checkOff(const std::string &path, const std::string &text, size_t positionsRead, uint64_t facesRead,
+              std::string *err) {
+    bool headerSeen = false, binary = false;
+    std::string counts;
+    size_t countsLine = 0;
+    forEachLine(text, [&](size_t n, std::string_view l) {
+        const std::string_view w = firstWord(l);
+        if (w.empty() || w[0] == '#') return true;
+        if (!headerSeen) {
+            headerSeen = true;
+            if (w.size() >= 3 && w.substr(w.size() - 3) == "OFF") {
+                binary = l.find("BINARY") != std::string_view::npos;
+                return true;
+            }
+        }
+        counts = std::string(l);
+        countsLine = n;
+        return false;
+    });
+    if (binary) return true;
+    std::istringstream in(counts);
+    long long nv = -1, nf = -1, ne = -1;
+    in >> nv >> nf >> ne;
+    if (!in || nv < 0 || nf < 0) {
+        *err = path + ":" + std::to_string(countsLine) + ": expected the OFF counts line 'VERTICES FACES EDGES'"
+               " (three integers; OpenMesh's reader needs the edge count, 0 is fine), got '" + counts + "'";
+        return false;
+    }
+    if (uint64_t(nv) != positionsRead || uint64_t(nf) != facesRead) {
+        *err = path + ": the header declares " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+               " faces but OpenMesh's OFF reader read " + std::to_string(positionsRead) + " and " +
+               std::to_string(facesRead) + "; OpenMesh's OFF reader does not accept '#' comment lines after the OFF keyword: remove them, and check the counts";
+        return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
+    auto fail = [&](const std::string &m) {
+        if (err) *err = m;
+        return false;
+    };
+    const std::string ext = lowerExtension(path);
+    if (ext != ".obj" && ext != ".ply" && ext != ".off" && ext != ".stl")
+        return fail(path + ": unsupported mesh format '" + ext + "'; supported: .obj .ply .off .stl");
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return fail(path + ": file not found");
+    if (std::filesystem::is_directory(path, ec)) return fail(path + ": is a directory, not a mesh file");
+    {
+        std::ifstream probe(path, std::ios::binary);
+        if (!probe) return fail(path + ": cannot open the file for reading (check its permissions)");
+        if (probe.peek() == std::ifstream::traits_type::eof()) return fail(path + ": the file is empty");
+    }
+
+    RawMesh m;
+    FaceRecorder rec(&m);
+    bool ok = false;
+    std::string log;
+    {
+        std::lock_guard<std::mutex> lock(gOpenMeshMutex);
+        CaptureOpenMeshLog capture;
+        OpenMesh::IO::Options opt;  // positions and faces only
+        try {
+            ok = OpenMesh::IO::IOManager().read(path, rec, opt);
+        } catch (const std::exception &e) {
+            ok = false;
+            log += std::string("exception: ") + e.what();
+        }
+        std::string t = capture.text();
+        if (!t.empty()) log = log.empty() ? t : t + "; " + log;
+    }
+    // Collapse the reader's log into one line for our messages, and keep it short (a reader may log
+    // once per bad face).
+    for (auto &c : log)
+        if (c == '\n' || c == '\r') c = ' ';
+    if (log.size() > 400) log = log.substr(0, 400) + "...";
+
+    if (!ok)
+        return fail(path + ": OpenMesh's " + ext.substr(1) + " reader could not read the file" +
+                    (log.empty() ? std::string() : " (reader said: " + log + ")") +
+                    "; check that it is a valid " + ext.substr(1) + " file");
+
+    // Our own checks where the readers are silent, and faces the reader never handed over (see the
+    // header comment): those are counted as dropped.
+    uint64_t inFile = m.facesRead;
+    if (ext == ".stl") {
+        uint64_t n = 0;
+        if (countStlFacets(path, &n) && n > m.facesRead) inFile = n;
+    } else if (ext == ".obj" || ext == ".off") {
+        std::string text;
+        if (!readAll(path, &text)) return fail(path + ": cannot read the file");
+        if (ext == ".obj") {
+            uint64_t faceLines = 0;
+            if (!checkObj(path, text, m.positions.size(), &faceLines, err)) return false;
+            inFile = std::max<uint64_t>(inFile, faceLines);
+        } else if (!checkOff(path, text, m.positions.size(), m.facesRead, err)) {
+            return false;
+        }
+    }
+    if (inFile > m.facesRead) {
+        const uint64_t skipped = inFile - m.facesRead;
+        m.facesDropped += skipped;
+        m.facesRead = inFile;
+        m.warnings.push_back(path + ": " + std::to_string(skipped) + " face(s) skipped by OpenMesh's " +
+                             ext.substr(1) + " reader (" +
+                             (ext == ".stl" ? std::string("facets with repeated vertices, or a truncated file") : std::string("faces with repeated or out-of-range vertex indices")) +
+                             "), counted as dropped");
+    }
+    if (rec.badIndexFaces)
+        m.warnings.push_back(path + ": " + std::to_string(rec.badIndexFaces) +
+                             " face(s) with invalid vertex indices dropped");
+    if (rec.tooFewFaces)
+        m.warnings.push_back(path + ": " + std::to_string(rec.tooFewFaces) +
+                             " face(s) with fewer than 3 distinct vertices dropped");
+    if (!log.empty())
+        m.warnings.push_back(path + ": reader said: " + log);
+    if (m.positions.size() > std::numeric_limits<uint32_t>::max())
+        return fail(path + ": more than 4294967295 vertices; visaudit's indices are 32-bit");
+    if (m.facesRead == 0 && m.positions.empty())
+        return fail(path + ": no vertices and no faces found; is this really a " + ext.substr(1) + " file?" +
+                    (log.empty() ? std::string() : " (reader said: " + log + ")"));
+    *out = std::move(m);
+    return true;
+}
+
+}  // namespace va

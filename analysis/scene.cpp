@@ -1,0 +1,230 @@
+// buildScene: source objects (world-space meshes, file order) -> the culling scene.
+//
+// Structure:
+//   1. Classify every source triangle (ids assigned objects-in-file-order, faces-in-file-order):
+//      non-finite, degenerate (zero area) or valid; compute its plane.
+//   2. Per source object, split its valid triangles into spatially coherent chunks (recursive median
+//      split of centroids along the longest axis) of at most ChunkSettings::maxTriangles.
+//   3. Per chunk (= culling object), copy the vertices its triangles use into one contiguous range of
+//      Scene::positions (vertices shared with another chunk are duplicated), rewrite the triangles'
+//      indices into that range, and compute its AABB and a conservative bounding sphere.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "analysis/scene.h"
+
+namespace va {
+namespace {
+
+// A valid triangle awaiting chunking: its centroid (times 3: only ordering matters) and its id.
+struct ChunkItem {
+    Vec3 centroid3;
+    uint32_t id;
+};
+
+// Recursive median split of items[b, e) until each range holds <= maxTris triangles; appends the
+// leaf ranges in left-to-right order. Deterministic: the median is an exact order statistic under a
+// total order (coordinate along the axis, then triangle id), so the partition does not depend on the
+// standard library's nth_element strategy.
+void splitChunks(std::vector<ChunkItem> &items, size_t b, size_t e, uint32_t maxTris,
+                 std::vector<std::pair<size_t, size_t>> *leaves) {
+    // Iterative with an explicit stack (right pushed first so leaves come out left to right).
+    std::vector<std::pair<size_t, size_t>> stack{{b, e}};
+    while (!stack.empty()) {
+        auto [lo, hi] = stack.back();
+        stack.pop_back();
+        if (hi - lo <= maxTris) {
+            leaves->push_back({lo, hi});
+            continue;
+        }
+        // Longest axis of the centroid bounds (ties: x before y before z).
+        Aabb cb;
+        for (size_t i = lo; i < hi; ++i) cb.extend(items[i].centroid3);
+        const Vec3 ext = cb.extent();
+        int axis = 0;
+        if (ext.y > ext[axis]) axis = 1;
+        if (ext.z > ext[axis]) axis = 2;
+        const size_t mid = lo + (hi - lo) / 2;
+        std::nth_element(items.begin() + lo, items.begin() + mid, items.begin() + hi,
+                         [axis](const ChunkItem &a, const ChunkItem &c) {
+                             const double ka = a.centroid3[axis], kc = c.centroid3[axis];
+                             return ka < kc || (ka == kc && a.id < c.id);
+                         });
+        stack.push_back({mid, hi});
+        stack.push_back({lo, mid});
+    }
+}
+
+bool fail(std::string *err, const std::string &m) {
+    if (err) *err = m;
+    return false;
+}
+
+}  // namespace
+
+bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *outScene, std::string *err) {
+    Scene s;
+    s.path = std::move(in.path);
+    s.up = in.up;
+    s.materials = std::move(in.materials);
+    if (s.materials.empty()) s.materials.push_back(Material{});
+    s.lights = std::move(in.lights);
+    s.views = std::move(in.views);
+    const uint32_t maxTris = std::max<uint32_t>(1, chunks.maxTriangles);
+
+    // Count source triangles; ids are uint32 and kExcludedTriangle is reserved for object ids only,
+    // so up to 2^32 - 1 triangles fit.
+    uint64_t total = 0;
+    for (const auto &o : in.objects) {
+        if (o.geometry.indices.size() % 3 != 0)
+            return fail(err, "object '" + o.name + "': index count " + std::to_string(o.geometry.indices.size()) +
+                                 " is not a multiple of 3 (internal error in the loader)");
+        if (o.material >= s.materials.size())
+            return fail(err, "object '" + o.name + "': material index " + std::to_string(o.material) +
+                                 " out of range (" + std::to_string(s.materials.size()) + " materials)");
+        total += o.geometry.indices.size() / 3;
+    }
+    if (total > std::numeric_limits<uint32_t>::max())
+        return fail(err, "the scene has " + std::to_string(total) +
+                             " triangles; at most 4294967295 fit visaudit's 32-bit triangle ids");
+
+    s.stats.sourceTriangles = total;
+    s.indices.assign(total * 3, 0);  // excluded triangles keep {0, 0, 0} (see scene.h)
+    s.triangleObject.assign(total, kExcludedTriangle);
+    s.planes.assign(total * 4, 0.0);  // excluded triangles keep the plane (0, 0, 0, 0)
+    s.objectTriangles.reserve(total);
+    s.positions.reserve(total / 2 + 16);  // a closed mesh has about half as many vertices as triangles
+
+    std::vector<ChunkItem> items;
+    std::vector<std::pair<size_t, size_t>> leaves;
+    std::vector<uint32_t> remap, stamp;  // per source vertex: new index, and the chunk that set it
+    uint64_t tri = 0;                    // global id of the object's first triangle
+
+    for (auto &o : in.objects) {
+        const RawMesh &g = o.geometry;
+        SourceObject src;
+        src.name = o.name;
+        src.mesh = o.mesh;
+        src.material = o.material;
+        src.firstTriangle = uint32_t(tri);
+        src.triangleCount = uint32_t(g.indices.size() / 3);
+        src.firstChunk = uint32_t(s.objects.size());
+        s.stats.facesDropped += g.facesDropped;
+        s.stats.polygonsTriangulated += g.polygonsTriangulated;
+        for (const auto &w : g.warnings) s.warnings.push_back(w);
+
+        // 1. Classify and compute planes.
+        items.clear();
+        const size_t nv = g.positions.size();
+        for (uint32_t t = 0; t < src.triangleCount; ++t) {
+            const uint32_t i0 = g.indices[3 * t], i1 = g.indices[3 * t + 1], i2 = g.indices[3 * t + 2];
+            if (i0 >= nv || i1 >= nv || i2 >= nv)
+                return fail(err, "object '" + o.name + "': triangle " + std::to_string(t) +
+                                     " has a vertex index outside its " + std::to_string(nv) +
+                                     " positions (internal error in the loader)");
+            const Vec3 v0 = g.positions[i0], v1 = g.positions[i1], v2 = g.positions[i2];
+            const uint64_t id = tri + t;
+            if (!isFinite(v0) || !isFinite(v1) || !isFinite(v2)) {
+                ++s.stats.nonFiniteTriangles;
+                continue;
+            }
+            // Zero area, decided exactly as far as double allows: equal vertices, or a cross product
+            // that is exactly zero (collinear, or so thin that every component underflows).
+            const Vec3 n = cross(v1 - v0, v2 - v0);
+            if (v0 == v1 || v1 == v2 || v0 == v2 || (n.x == 0 && n.y == 0 && n.z == 0)) {
+                ++s.stats.degenerateTriangles;
+                continue;
+            }
+            // Finite coordinates can still overflow the cross product (|coordinates| > ~1e154); such a
+            // plane is not representable, so the triangle is counted as non-finite.
+            const double k = -dot(n, v0);
+            if (!isFinite(n) || !std::isfinite(k)) {
+                ++s.stats.nonFiniteTriangles;
+                continue;
+            }
+            double *p = &s.planes[4 * id];
+            p[0] = n.x, p[1] = n.y, p[2] = n.z, p[3] = k;
+            items.push_back({v0 + v1 + v2, uint32_t(id)});
+        }
+
+        // 2. Chunks. A source object small enough stays one object (named without "#k").
+        leaves.clear();
+        if (!items.empty()) splitChunks(items, 0, items.size(), maxTris, &leaves);
+        const bool split = leaves.size() > 1;
+
+        // 3. Vertex ranges, index rewrite, bounds.
+        remap.assign(nv, 0);
+        stamp.assign(nv, kExcludedTriangle);
+        for (size_t c = 0; c < leaves.size(); ++c) {
+            auto [lo, hi] = leaves[c];
+            // Source order within the object.
+            std::sort(items.begin() + lo, items.begin() + hi,
+                      [](const ChunkItem &a, const ChunkItem &b) { return a.id < b.id; });
+            if (s.objects.size() >= kExcludedTriangle - 1)
+                return fail(err, "the scene would have more than 2^32 - 2 culling objects; raise the chunk size");
+            const uint32_t objIndex = uint32_t(s.objects.size());
+            SceneObject so;
+            so.name = split ? o.name + "#" + std::to_string(c) : o.name;
+            so.source = uint32_t(s.sources.size());
+            so.material = o.material;
+            so.vertexBegin = uint32_t(s.positions.size());
+            so.triBegin = uint32_t(s.objectTriangles.size());
+            for (size_t i = lo; i < hi; ++i) {
+                const uint32_t id = items[i].id;
+                const uint32_t t = uint32_t(id - tri);
+                for (int k = 0; k < 3; ++k) {
+                    const uint32_t v = g.indices[3 * t + k];
+                    if (stamp[v] != objIndex) {
+                        if (s.positions.size() >= std::numeric_limits<uint32_t>::max())
+                            return fail(err, "the scene needs more than 4294967295 vertices after chunking "
+                                             "(visaudit's indices are 32-bit); split the level into smaller files");
+                        stamp[v] = objIndex;
+                        remap[v] = uint32_t(s.positions.size());
+                        s.positions.push_back(g.positions[v]);
+                        so.bounds.extend(g.positions[v]);
+                    }
+                    s.indices[3 * size_t(id) + k] = remap[v];
+                }
+                s.triangleObject[id] = objIndex;
+                s.objectTriangles.push_back(id);
+            }
+            so.vertexEnd = uint32_t(s.positions.size());
+            so.triEnd = uint32_t(s.objectTriangles.size());
+
+            // Conservative bounding sphere: center = AABB center, radius = the largest computed
+            // distance to a vertex, rounded up. A computed dot(d, d) has at most 5 rounded operations
+            // along any path (subtraction, square, two additions; all terms are >= 0), so it is within
+            // a relative gamma(5) of the true squared distance; the sqrt halves that and adds half an
+            // ulp, leaving the distance within a relative gamma(4). Scaling by (1 + gamma(6)) (itself
+            // rounded by at most half an ulp, covered by the slack) makes the radius an upper bound.
+            so.sphere.center = so.bounds.center();
+            double r2 = 0;
+            for (uint32_t v = so.vertexBegin; v < so.vertexEnd; ++v) {
+                const Vec3 d = s.positions[v] - so.sphere.center;
+                r2 = std::max(r2, dot(d, d));
+            }
+            so.sphere.radius = std::sqrt(r2) * (1 + gamma(6));
+            s.bounds.extend(so.bounds);
+            s.objects.push_back(std::move(so));
+        }
+        src.chunkCount = uint32_t(leaves.size());
+        s.sources.push_back(std::move(src));
+        tri += g.indices.size() / 3;
+        o.geometry = RawMesh{};  // release the source mesh as soon as it has been copied
+    }
+    for (auto &w : in.warnings) s.warnings.push_back(std::move(w));
+    s.positions.shrink_to_fit();
+    *outScene = std::move(s);
+    return true;
+}
+
+Scene buildScene(SceneBuildInput &&in, const ChunkSettings &chunks) {
+    Scene s;
+    std::string err;
+    if (!buildScene(std::move(in), chunks, &s, &err)) throw std::runtime_error("buildScene: " + err);
+    return s;
+}
+
+}  // namespace va
