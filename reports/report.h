@@ -1,7 +1,9 @@
 // Report outputs: report.json (docs/report-schema.json) and the per-view images.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -12,11 +14,68 @@ namespace va {
 constexpr const char *kReportFormat = "visaudit-report/1";
 
 // The whole report as JSON (ordered keys, deterministic: no timestamps outside "ms" fields).
+// Doubles are always finite: a value that is not (an empty scene's bounds, a ratio over zero
+// pixels) is written as null; docs/report-schema.json says which fields can be null.
 nlohmann::ordered_json reportJson(const AnalysisResult &result);
 
-// Writes NAME.depth.exr, NAME.depth.png, NAME.overdraw.png and NAME.ids.exr for one view into dir.
-bool writeViewImages(const ViewResult &view, const std::string &dir, std::string *err);
+// ---- Image file names ------------------------------------------------------------------------
+// A view name made safe as a file name: [A-Za-z0-9._-] kept, every other byte replaced by '_'
+// (a multi-byte UTF-8 character becomes one '_' per byte), a leading '.' replaced by '_' (no
+// hidden files, no "." or ".."), empty -> "view", cut to kMaxImageBaseName bytes.
+constexpr size_t kMaxImageBaseName = 200;
+std::string sanitizeFileName(const std::string &viewName);
+// The image base names of all views, in view order: sanitizeFileName of each, with collisions
+// (compared case-insensitively, so they stay distinct on macOS/Windows file systems) resolved in
+// view order by appending "-2", "-3", ...: the first view keeps the plain name. Deterministic.
+std::vector<std::string> imageBaseNames(const std::vector<ViewResult> &views);
 
+// The image files of one view, named from its base name (the keys are report.json's "images").
+struct ViewImageNames {
+    std::string depthExr;     // BASE.depth.exr
+    std::string depthPng;     // BASE.depth.png
+    std::string overdrawPng;  // BASE.overdraw.png
+    std::string idsExr;       // BASE.ids.exr
+};
+ViewImageNames viewImageNames(const std::string &baseName);
+
+// ---- Images ------------------------------------------------------------------------------------
+// Writes BASE.depth.exr, BASE.depth.png, BASE.overdraw.png and BASE.ids.exr for one view into dir
+// (each to a temporary name in dir, then renamed). Needs view.buffer (width x height). On failure
+// returns false with the path and OpenImageIO's message.
+bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
+                     std::string *err);
+// As above with baseName = sanitizeFileName(view name): for a single view only; use
+// writeAllViewImages (or imageBaseNames) when view names may collide.
+bool writeViewImages(const ViewResult &view, const std::string &dir, std::string *err);
+// Every view's images with the names imageBaseNames gives (the names report.json lists).
+bool writeAllViewImages(const AnalysisResult &result, const std::string &dir, std::string *err);
+
+// An image read back as stored (for tests and golden-image comparison). Exactly one pixel vector
+// is filled, the one matching the file's pixel type; channels are interleaved, rows top-down.
+struct ImageData {
+    int width = 0, height = 0;
+    std::vector<std::string> channelNames;
+    std::string pixelType;       // OpenImageIO TypeDesc name: "float", "uint" (32-bit), "uint8"
+    std::vector<float> f32;      // pixelType "float"
+    std::vector<uint32_t> u32;   // pixelType "uint"
+    std::vector<uint8_t> u8;     // pixelType "uint8"
+    int channels() const { return int(channelNames.size()); }
+};
+bool readImage(const std::string &path, ImageData *out, std::string *err);
+
+// The overdraw heatmap's color for a depth complexity (fragments at a pixel) on a scale capped at
+// `cap` (values above it take the top color): 0 = black, 1 = the ramp's start (blue), cap = white.
+struct Rgb8 {
+    uint8_t r = 0, g = 0, b = 0;
+    bool operator==(const Rgb8 &) const = default;
+};
+Rgb8 overdrawColor(uint32_t fragments, uint32_t cap);
+// The 8-bit gray of a view depth in the depth PNG (log scale between the view's minimum and
+// maximum finite depth): dMin -> 255 (white), dMax -> kDepthPngFarGray, background -> 0.
+constexpr uint8_t kDepthPngFarGray = 40;
+uint8_t depthGray(double d, double dMin, double dMax);
+
+// ---- Files and folders -----------------------------------------------------------------------
 // Writes a text file atomically (temporary name in the same folder, then rename).
 bool writeFileAtomic(const std::string &path, const std::string &contents, std::string *err);
 
@@ -25,8 +84,16 @@ bool writeFileAtomic(const std::string &path, const std::string &contents, std::
 // report folder (holds report.json) or empty; anything else is refused, never deleted.
 class OutputDir {
   public:
+    OutputDir() = default;
+    OutputDir(const OutputDir &) = delete;
+    OutputDir &operator=(const OutputDir &) = delete;
+
     bool open(const std::string &target, std::string *err);
     const std::string &staging() const { return staging_; }
+    const std::string &target() const { return target_; }
+    // Swaps the staging folder in. Returns false (old target restored) when the swap fails. When
+    // the swap succeeded but the replaced old folder could not be removed, returns true and *err
+    // holds a warning naming the leftover folder.
     bool commit(std::string *err);
     ~OutputDir();  // removes the staging folder unless committed
 

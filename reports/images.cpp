@@ -1,0 +1,294 @@
+// Per-view images through OpenImageIO (the only file that includes OIIO headers).
+//
+//   BASE.depth.exr     one FLOAT channel "Z": the visible fragment's view depth d (double rounded to
+//                      float); background (no fragment) = +inf, so "nothing" is never mistaken for a
+//                      depth and min() over a region still picks the nearest surface.
+//   BASE.depth.png     8-bit gray visualization of the same depths (depthGray: log scale, near
+//                      white, far dark, background black).
+//   BASE.overdraw.png  RGB heatmap of depth complexity (ZBuffer::fragments per pixel) with a legend
+//                      strip added below the image (the image itself is never covered).
+//   BASE.ids.exr       one UINT32 channel "id": 1 + the visible source triangle index, 0 = background.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+
+#include "reports/font.h"
+#include "reports/report.h"
+
+namespace va {
+
+namespace {
+
+using OIIO::ImageInput;
+using OIIO::ImageOutput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+std::atomic<unsigned> gTempCounter{0};
+
+// Writes one image with OpenImageIO to a temporary name in the same folder, then renames it over
+// `path` (rename within one folder is atomic: readers see the old file or the new one, never half).
+// `format` names the OIIO writer ("openexr", "png") because the temporary name has no extension.
+bool writeImageAtomic(const std::string &path, const char *format, const ImageSpec &spec, const void *pixels,
+                      std::string *err) {
+    const std::string tmp =
+        path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gTempCounter.fetch_add(1));
+    auto fail = [&](const std::string &msg) {
+        std::remove(tmp.c_str());
+        if (err) *err = "cannot write image '" + path + "': " + msg;
+        return false;
+    };
+    auto out = ImageOutput::create(format);
+    if (!out) return fail("no OpenImageIO writer for " + std::string(format) + ": " + OIIO::geterror());
+    if (!out->open(tmp, spec)) return fail(out->geterror());
+    if (!out->write_image(spec.format, pixels)) {
+        const std::string msg = out->geterror();
+        out->close();
+        return fail(msg);
+    }
+    if (!out->close()) return fail(out->geterror());
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) return fail(std::string("rename: ") + std::strerror(errno));
+    return true;
+}
+
+// ---- Overdraw legend layout -------------------------------------------------------------------
+// The legend is a row of swatches with their values below, right-aligned in a strip that extends
+// the canvas below the image. All sizes are multiples of the font scale s:
+//   strip height = margin 3s + swatch 6s + gap 2s + text 7s + margin 3s = 21s
+//   cell width   = max(widest label, 7s) + 2s (the last 2s is the gap to the next swatch)
+constexpr Rgb8 kStripBackground{24, 24, 24};
+constexpr Rgb8 kLegendText{255, 255, 255};
+constexpr Rgb8 kSwatchOutline{160, 160, 160};
+
+// Values shown in the legend: every value 0..cap when that is at most 17 swatches, otherwise
+// 0, 1 and eight evenly spaced values up to cap.
+std::vector<uint32_t> legendValues(uint32_t cap) {
+    std::vector<uint32_t> v;
+    if (cap <= 16) {
+        for (uint32_t i = 0; i <= cap; ++i) v.push_back(i);
+    } else {
+        v = {0, 1};
+        for (int k = 1; k <= 8; ++k) v.push_back(1 + uint32_t(std::lround(double(cap - 1) * k / 8.0)));
+    }
+    return v;
+}
+
+struct LegendLayout {
+    int scale = 1, margin = 0, swatchH = 0, cellW = 0, stripH = 0, width = 0;
+};
+LegendLayout legendLayout(const std::vector<uint32_t> &values, int imageWidth) {
+    LegendLayout L;
+    L.scale = imageWidth >= 1024 ? 2 : 1;
+    const int s = L.scale;
+    int labelW = 0;
+    for (uint32_t v : values) labelW = std::max(labelW, textWidth(std::to_string(v), s));
+    L.margin = 3 * s;
+    L.swatchH = 6 * s;
+    L.cellW = std::max(labelW, 7 * s) + 2 * s;
+    L.stripH = L.margin + L.swatchH + 2 * s + textHeight(s) + L.margin;
+    L.width = int(values.size()) * L.cellW - 2 * s;
+    return L;
+}
+
+void fillRect(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c) {
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            uint8_t *p = &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3];
+            p[0] = c.r;
+            p[1] = c.g;
+            p[2] = c.b;
+        }
+}
+
+}  // namespace
+
+// ---- Color mappings ---------------------------------------------------------------------------
+
+// Depth complexity ramp: a fixed piecewise-linear ramp through blue, cyan, green, yellow, red and
+// white (lightness rises along it, so a gray-scale print still orders the values). A value v >= 1
+// sits at t = (min(v, cap) - 1) / (cap - 1) in [0, 1]; each channel is interpolated between the two
+// stops around t and rounded. 0 fragments (nothing drawn) is black, outside the ramp.
+Rgb8 overdrawColor(uint32_t fragments, uint32_t cap) {
+    struct Stop {
+        double t;
+        Rgb8 c;
+    };
+    static constexpr Stop kStops[] = {
+        {0.00, {32, 64, 255}},  {0.25, {0, 200, 255}}, {0.50, {48, 220, 48}},
+        {0.75, {255, 220, 0}},  {0.90, {255, 32, 0}},  {1.00, {255, 255, 255}},
+    };
+    if (fragments == 0) return {0, 0, 0};
+    const double t = cap <= 1 ? 0.0 : double(std::min(fragments, cap) - 1) / double(cap - 1);
+    for (size_t i = 1; i < std::size(kStops); ++i) {
+        if (t > kStops[i].t) continue;
+        const Stop &a = kStops[i - 1], &b = kStops[i];
+        const double u = (t - a.t) / (b.t - a.t);
+        auto lerp = [u](uint8_t x, uint8_t y) { return uint8_t(std::lround(x + (double(y) - x) * u)); };
+        return {lerp(a.c.r, b.c.r), lerp(a.c.g, b.c.g), lerp(a.c.b, b.c.b)};
+    }
+    return kStops[std::size(kStops) - 1].c;
+}
+
+// Depth visualization: perspective depth spans orders of magnitude (0.1 .. 1000), so a linear ramp
+// would put everything near the camera in one gray. On a log scale equal depth *ratios* get equal
+// gray steps:  t = (ln d - ln dMin) / (ln dMax - ln dMin) in [0, 1],
+//              gray = round(255 - t * (255 - kDepthPngFarGray)).
+// The nearest surface of the view is white, the farthest kDepthPngFarGray (kept above 0 so that the
+// farthest geometry is still distinguishable from the black background). dMin == dMax: all white.
+uint8_t depthGray(double d, double dMin, double dMax) {
+    if (!std::isfinite(d) || !(d > 0) || !(dMin > 0) || !std::isfinite(dMax)) return 0;
+    double t = 0;
+    if (dMax > dMin) t = (std::log(d) - std::log(dMin)) / (std::log(dMax) - std::log(dMin));
+    t = std::clamp(t, 0.0, 1.0);
+    return uint8_t(std::lround(255.0 - t * (255.0 - kDepthPngFarGray)));
+}
+
+// ---- Writing ----------------------------------------------------------------------------------
+
+bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
+                     std::string *err) {
+    const ZBuffer &zb = view.buffer;
+    const int W = zb.width, H = zb.height;
+    const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
+    if (W <= 0 || H <= 0 || zb.depth.size() != n || zb.id.size() != n || zb.fragments.size() != n) {
+        if (err)
+            *err = "view '" + view.spec.name + "': no per-pixel buffers of " + std::to_string(W) + "x" +
+                   std::to_string(H) + " pixels to write images from (were they released before writing?)";
+        return false;
+    }
+    const ViewImageNames names = viewImageNames(baseName);
+    const std::string prefix = dir.empty() ? std::string() : (dir.back() == '/' ? dir : dir + "/");
+
+    // BASE.depth.exr: view depth as float, +inf where nothing was drawn.
+    {
+        std::vector<float> z(n);
+        for (size_t i = 0; i < n; ++i) z[i] = float(zb.depth[i]);
+        ImageSpec spec(W, H, 1, TypeDesc::FLOAT);
+        spec.channelnames = {"Z"};
+        spec.z_channel = 0;
+        spec.attribute("compression", "zip");
+        if (!writeImageAtomic(prefix + names.depthExr, "openexr", spec, z.data(), err)) return false;
+    }
+
+    // BASE.depth.png: log-scaled gray between the view's nearest and farthest finite depth.
+    {
+        double dMin = INFINITY, dMax = -INFINITY;
+        for (double d : zb.depth)
+            if (std::isfinite(d) && d > 0) {
+                dMin = std::min(dMin, d);
+                dMax = std::max(dMax, d);
+            }
+        std::vector<uint8_t> gray(n);
+        for (size_t i = 0; i < n; ++i) gray[i] = depthGray(zb.depth[i], dMin, dMax);
+        ImageSpec spec(W, H, 1, TypeDesc::UINT8);
+        spec.channelnames = {"Y"};
+        if (!writeImageAtomic(prefix + names.depthPng, "png", spec, gray.data(), err)) return false;
+    }
+
+    // BASE.overdraw.png: heatmap of fragments per pixel, scale capped at max(8, most fragments), with
+    // the legend in a strip below the image (the canvas widens if the legend is wider than the image).
+    {
+        uint32_t maxFragments = 0;
+        for (uint16_t f : zb.fragments) maxFragments = std::max<uint32_t>(maxFragments, f);
+        const uint32_t cap = std::max<uint32_t>(8, maxFragments);
+        const std::vector<uint32_t> values = legendValues(cap);
+        const LegendLayout L = legendLayout(values, W);
+        const int CW = std::max(W, L.width + 2 * L.margin), CH = H + L.stripH;
+        std::vector<uint8_t> rgb(size_t(CW) * size_t(CH) * 3);
+        fillRect(rgb, CW, 0, 0, CW, CH, kStripBackground);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const Rgb8 c = overdrawColor(zb.fragments[size_t(y) * size_t(W) + size_t(x)], cap);
+                fillRect(rgb, CW, x, y, x + 1, y + 1, c);
+            }
+        // Legend, right-aligned: swatch i spans [x_i, x_i + cellW - 2s) x [top, top + swatchH), with a
+        // one-cell outline so that the black "0" swatch shows on the dark strip; its label is centered
+        // below it.
+        const int s = L.scale;
+        const int x0 = CW - L.margin - L.width, top = H + L.margin;
+        for (size_t i = 0; i < values.size(); ++i) {
+            const int xi = x0 + int(i) * L.cellW, sw = L.cellW - 2 * s;
+            fillRect(rgb, CW, xi, top, xi + sw, top + L.swatchH, kSwatchOutline);
+            fillRect(rgb, CW, xi + s, top + s, xi + sw - s, top + L.swatchH - s, overdrawColor(values[i], cap));
+            const std::string label = std::to_string(values[i]);
+            const int lx = xi + (sw - textWidth(label, s)) / 2, ly = top + L.swatchH + 2 * s;
+            drawText(rgb.data(), CW, CH, lx, ly, label, {kLegendText.r, kLegendText.g, kLegendText.b}, s);
+        }
+        ImageSpec spec(CW, CH, 3, TypeDesc::UINT8);
+        spec.attribute("visaudit:overdraw_cap", int(cap));
+        if (!writeImageAtomic(prefix + names.overdrawPng, "png", spec, rgb.data(), err)) return false;
+    }
+
+    // BASE.ids.exr: 1 + visible source triangle index as UINT32 (OpenEXR's 32-bit unsigned pixel
+    // type holds every id exactly, unlike a float channel, which would round ids above 2^24).
+    {
+        ImageSpec spec(W, H, 1, TypeDesc::UINT32);
+        spec.channelnames = {"id"};
+        spec.attribute("compression", "zip");
+        if (!writeImageAtomic(prefix + names.idsExr, "openexr", spec, zb.id.data(), err)) return false;
+    }
+    return true;
+}
+
+bool writeViewImages(const ViewResult &view, const std::string &dir, std::string *err) {
+    return writeViewImages(view, dir, sanitizeFileName(view.spec.name), err);
+}
+
+bool writeAllViewImages(const AnalysisResult &result, const std::string &dir, std::string *err) {
+    const std::vector<std::string> bases = imageBaseNames(result.views);
+    for (size_t i = 0; i < result.views.size(); ++i)
+        if (!writeViewImages(result.views[i], dir, bases[i], err)) return false;
+    return true;
+}
+
+// ---- Reading ----------------------------------------------------------------------------------
+
+bool readImage(const std::string &path, ImageData *out, std::string *err) {
+    auto in = ImageInput::open(path);
+    if (!in) {
+        if (err) *err = "cannot read image '" + path + "': " + OIIO::geterror();
+        return false;
+    }
+    const ImageSpec &spec = in->spec();
+    ImageData d;
+    d.width = spec.width;
+    d.height = spec.height;
+    d.channelNames = spec.channelnames;
+    // Per-channel formats may differ; read every channel in the first channel's type (what our
+    // writers produce: one type per file).
+    const TypeDesc type = spec.channelformats.empty() ? spec.format : spec.channelformats[0];
+    d.pixelType = type.c_str();
+    const size_t count = size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels);
+    void *pixels = nullptr;
+    if (type == TypeDesc::FLOAT) {
+        d.f32.resize(count);
+        pixels = d.f32.data();
+    } else if (type == TypeDesc::UINT32) {
+        d.u32.resize(count);
+        pixels = d.u32.data();
+    } else if (type == TypeDesc::UINT8) {
+        d.u8.resize(count);
+        pixels = d.u8.data();
+    } else {
+        if (err) *err = "cannot read image '" + path + "': unsupported pixel type " + d.pixelType;
+        return false;
+    }
+    if (!in->read_image(0, 0, 0, spec.nchannels, type, pixels)) {
+        if (err) *err = "cannot read image '" + path + "': " + in->geterror();
+        return false;
+    }
+    in->close();
+    *out = std::move(d);
+    return true;
+}
+
+}  // namespace va
