@@ -1,0 +1,325 @@
+// Exact cases for the frustum, backface and clip stages and the pipeline that joins them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "analysis/backface.h"
+#include "analysis/demo.h"
+#include "analysis/frustum.h"
+#include "analysis/pipeline.h"
+
+using namespace va;
+
+namespace {
+
+Scene sceneOf(std::vector<RawMesh> meshes, std::vector<Material> mats = {Material{}},
+              std::vector<uint32_t> matOf = {}) {
+    SceneBuildInput in;
+    in.materials = std::move(mats);
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        SceneBuildInput::Object o;
+        o.name = "o" + std::to_string(i);
+        o.material = i < matOf.size() ? matOf[i] : 0;
+        o.geometry = std::move(meshes[i]);
+        in.objects.push_back(std::move(o));
+    }
+    return buildScene(std::move(in));
+}
+
+RawMesh triangleMesh(Vec3 a, Vec3 b, Vec3 c) {
+    RawMesh m;
+    m.positions = {a, b, c};
+    m.indices = {0, 1, 2};
+    m.facesRead = 1;
+    return m;
+}
+
+ViewSpec viewOf(Vec3 eye, Vec3 target, int w = 64, int h = 48, double fov = 60, double nearZ = 0.1,
+                double farZ = 100) {
+    ViewSpec v;
+    v.name = "v";
+    v.camera.eye = eye;
+    v.camera.target = target;
+    v.camera.fovYDegrees = fov;
+    v.camera.nearZ = nearZ;
+    v.camera.farZ = farZ;
+    v.camera.width = w;
+    v.camera.height = h;
+    return v;
+}
+
+ViewResult run(const Scene &scene, const ViewSpec &view, PipelineSettings s = {}) {
+    ViewSpec resolved;
+    Camera cam;
+    std::string err;
+    EXPECT_TRUE(resolveView(view, s, &resolved, &cam, &err)) << err;
+    const PreparedScene ps = prepareScene(scene);
+    return analyzeView(ps, resolved, cam, s);
+}
+
+const StageRecord &stage(const ViewResult &r, const std::string &name) {
+    for (const StageRecord &s : r.stages)
+        if (s.name == name) return s;
+    static StageRecord none;
+    ADD_FAILURE() << "no stage " << name;
+    return none;
+}
+
+}  // namespace
+
+TEST(Backface, CubeFromGenericEyeCullsExactlySixOfTwelve) {
+    const Scene scene = sceneOf({boxMesh({0, 0, 0}, {1, 1, 1})});
+    ASSERT_EQ(scene.objectTriangles.size(), 12u);
+    // Generic eyes: each sees exactly three faces of the cube.
+    for (Vec3 eye : {Vec3{3.1, 2.3, 4.7}, Vec3{-5.2, 1.9, -3.3}, Vec3{2.2, -4.1, 1.7}}) {
+        const ViewResult r = run(scene, viewOf(eye, {0, 0, 0}));
+        EXPECT_EQ(r.backface.trianglesTested, 12u);
+        EXPECT_EQ(r.backface.trianglesCulled, 6u);
+        EXPECT_EQ(stage(r, "backface").trianglesOut, 6u);
+    }
+    // An eye in the planes x = 1 and y = 1 of two faces: those four triangles are edge-on (plane
+    // exactly 0 at the eye) and culled; only the +z face's two triangles survive.
+    const ViewResult r = run(scene, viewOf({1, 1, 5}, {0, 0, 0}));
+    EXPECT_EQ(r.backface.trianglesCulled, 10u);
+    EXPECT_EQ(r.backface.edgeOn, 4u);
+}
+
+TEST(Backface, DoubleSidedMaterialIsExempt) {
+    Material ds;
+    ds.name = "ds";
+    ds.doubleSided = true;
+    const Scene scene = sceneOf({boxMesh({0, 0, 0}, {1, 1, 1}), boxMesh({3, 0, 0}, {1, 1, 1})}, {Material{}, ds},
+                                {0, 1});
+    const ViewResult r = run(scene, viewOf({1.5, 2.3, 9.7}, {1.5, 0, 0}));
+    EXPECT_EQ(r.backface.trianglesTested, 12u);
+    EXPECT_EQ(r.backface.doubleSidedExempt, 12u);
+    EXPECT_EQ(r.backface.trianglesCulled, 6u);
+}
+
+TEST(Backface, EyeExactlyOnTrianglePlaneIsEdgeOnExactly) {
+    // The eye lies exactly on the triangle's plane z = 0.1 + 0.2 (not representable: decided
+    // exactly by the orientation predicate, never by a rounded dot product).
+    const double z = 0.1 + 0.2;
+    const Scene scene = sceneOf({triangleMesh({-1, -1, z}, {1, -1, z}, {0, 1, z})});
+    bool edgeOn = false;
+    Camera cam;
+    std::string err;
+    CameraSpec cs;
+    cs.eye = {0.3, 0.7, z};
+    cs.target = {0, 0, -5};
+    ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+    EXPECT_FALSE(isFrontFacing(scene, 0, cam, &edgeOn));
+    EXPECT_TRUE(edgeOn);
+}
+
+TEST(Clip, TriangleCrossingNearPlaneIsClippedToAQuad) {
+    // Camera at the origin looking down -z; near = 1. One vertex at d = 0.5 (in front of the eye,
+    // behind near), two at d = 3.
+    const Scene scene = sceneOf({triangleMesh({0, 0.2, -0.5}, {-1, -0.5, -3}, {1, -0.5, -3})});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}, 64, 48, 90, 1.0, 100));
+    EXPECT_EQ(r.clip.clipped, 1u);
+    EXPECT_EQ(r.clip.perPlane[kPlaneNear], 1u);
+    EXPECT_EQ(r.clip.polygonVertices[4], 1u);
+    EXPECT_EQ(r.clip.trianglesOut, 2u);
+    EXPECT_GT(r.zbuffer.coveredPixels, 0u);
+    // Every fragment lies at or beyond near (nothing from in front of the near plane is drawn).
+    for (size_t i = 0; i < r.buffer.depth.size(); ++i)
+        if (r.buffer.id[i]) EXPECT_GE(r.buffer.depth[i], 1.0 * (1 - 1e-12));
+}
+
+TEST(Clip, VertexBehindEyeNothingDrawnFromBehind) {
+    // One vertex behind the eye (d = -2): the projected triangle would wrap around through infinity
+    // if it were divided before clipping. Compare coverage with a ray-plane reference.
+    const Vec3 a{0, 0.5, 2}, b{-2, -1, -4}, c{2, -1, -4};
+    const Scene scene = sceneOf({triangleMesh(a, b, c)});
+    const ViewSpec view = viewOf({0, 0, 0}, {0, 0, -1}, 64, 48, 90, 0.5, 100);
+    const ViewResult r = run(scene, view);
+    EXPECT_EQ(r.clip.perPlane[kPlaneNear], 1u);
+    // Reference: the pixel-center ray hits the triangle at depth >= near. Pixels whose center lies
+    // within 1e-3 pixel of the clipped polygon's boundary may go either way (snapping).
+    const Camera &cam = r.camera;
+    int mismatches = 0, covered = 0;
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            const ViewRay ray = viewRayThroughPixel(cam, x + 0.5, y + 0.5);
+            const Vec3 dir = transformVector(transpose(cam.viewFromWorld), ray.direction);
+            // Moller-Trumbore in world space from the eye.
+            const Vec3 e1 = b - a, e2 = c - a, p = cross(dir, e2);
+            const double det = dot(e1, p);
+            const Vec3 s = cam.eye - a;
+            const double u = dot(s, p) / det;
+            const Vec3 q = cross(s, e1);
+            const double v = dot(dir, q) / det, t = dot(e2, q) / det;
+            const bool hit = u >= 0 && v >= 0 && u + v <= 1 && t >= 0.5;
+            const bool margin = std::fabs(u) < 1e-3 || std::fabs(v) < 1e-3 || std::fabs(1 - u - v) < 1e-3 ||
+                                std::fabs(t - 0.5) < 1e-3;
+            const bool drawn = r.buffer.id[size_t(y) * cam.width + x] != 0;
+            covered += drawn;
+            if (hit != drawn && !margin) ++mismatches;
+        }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_GT(covered, 100);
+}
+
+TEST(Clip, TriangleEntirelyBehindEyeIsTriviallyRejected) {
+    const Scene scene = sceneOf({triangleMesh({-1, 0, 3}, {1, 0, 3}, {0, 1, 3})});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), PipelineSettings{false, false});
+    EXPECT_EQ(r.clip.trianglesIn, 1u);
+    EXPECT_EQ(r.clip.trivialRejected, 1u);
+    EXPECT_EQ(r.zbuffer.fragments, 0u);
+}
+
+TEST(Clip, VertexExactlyOnNearPlaneIsInside) {
+    // Camera at the origin looking down -z: view depth d = -z exactly, so d = near exactly.
+    const Scene scene = sceneOf({triangleMesh({0, 0, -1}, {-1, -1, -3}, {1, -1, -3})});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}, 64, 48, 90, 1.0, 100));
+    EXPECT_EQ(r.clip.inside, 1u);
+    EXPECT_EQ(r.clip.clipped, 0u);
+}
+
+TEST(Clip, TriangleInAFrustumSidePlaneIsEdgeOn) {
+    // All three vertices on the plane through the eye x = 0 (perspective): seen edge-on.
+    const Scene scene = sceneOf({triangleMesh({0, 0, -2}, {0, 1, -3}, {0, -1, -4})});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), PipelineSettings{false, false});
+    EXPECT_EQ(r.clip.edgeOn, 1u);
+    EXPECT_EQ(r.zbuffer.fragments, 0u);
+}
+
+TEST(Clip, HugeTriangleIsClippedAtTheGuardBandAndCoversEverything) {
+    // A triangle whose projection spans ~1e9 pixels: clipped against the guard band, it must still
+    // cover every pixel of the view exactly once.
+    const Scene scene = sceneOf({triangleMesh({-1e7, -1e7, -5}, {1e7, -1e7, -5}, {0, 1e7, -5})});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), PipelineSettings{false, false});
+    EXPECT_EQ(r.clip.clipped, 1u);
+    EXPECT_EQ(r.zbuffer.coveredPixels, 64u * 48u);
+    EXPECT_EQ(r.zbuffer.fragments, 64u * 48u);
+}
+
+TEST(Pipeline, ClosedMeshWithBackfaceCullingCoversEachPixelOnce) {
+    const Scene scene = sceneOf({uvSphereMesh({0.3, -0.2, 0}, 1, 64, 32)});
+    for (Vec3 eye : {Vec3{0.5, 0.4, 4}, Vec3{-2.7, 1.1, 1.6}, Vec3{1.9, 0.4, 0.9}}) {
+        const ViewResult r = run(scene, viewOf(eye, {0, 0, 0}, 160, 120));
+        EXPECT_GT(r.zbuffer.coveredPixels, 1000u);
+        EXPECT_EQ(r.zbuffer.fragments, r.zbuffer.coveredPixels);  // no crack, no double cover
+        EXPECT_EQ(r.zbuffer.maxDepthComplexity, 1u);
+        EXPECT_EQ(r.zbuffer.overdraw, 1.0);
+    }
+}
+
+TEST(Pipeline, PowerOfTwoScalesGiveIdenticalImages) {
+    // Scaling the scene, the eye and near/far by 2^k is exact in binary floating point, so every
+    // computation scales exactly and the coverage must be identical at 1e-6 and 1e6 magnitudes.
+    auto render = [&](double s) {
+        RawMesh m = uvSphereMesh({0.3 * s, -0.2 * s, 0}, 1 * s, 32, 16);
+        RawMesh t = triangleMesh(Vec3{-3, -2, -1} * s, Vec3{3, -2, -1} * s, Vec3{0, 3, -1.5} * s);
+        const Scene scene = sceneOf({m, t});
+        return run(scene, viewOf(Vec3{0.5, 0.4, 4} * s, {0, 0, 0}, 96, 64, 60, 0.1 * s, 100 * s));
+    };
+    const ViewResult ref = render(1);
+    for (double s : {std::ldexp(1.0, -20), std::ldexp(1.0, 20)}) {
+        const ViewResult r = render(s);
+        EXPECT_EQ(r.buffer.id, ref.buffer.id) << "scale " << s;
+        EXPECT_EQ(r.zbuffer.fragments, ref.zbuffer.fragments);
+    }
+}
+
+TEST(Frustum, BvhWalkEqualsBruteForceAndTestsFewerPlanes) {
+    // 20 x 20 boxes on a grid; several views; the BVH result equals testing each object.
+    std::vector<RawMesh> boxes;
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j) boxes.push_back(boxMesh({i * 3.0, 0, j * 3.0}, {0.5, 0.5, 0.5}));
+    const Scene scene = sceneOf(boxes);
+    const ObjectBvh bvh = buildObjectBvh(scene);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-10, 70);
+    for (int k = 0; k < 20; ++k) {
+        CameraSpec cs;
+        cs.eye = {u(rng), u(rng) * 0.2, u(rng)};
+        cs.target = {u(rng), 0, u(rng)};
+        cs.nearZ = 0.1;
+        cs.farZ = 20 + k * 3;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+        const FrustumResult f = cullFrustum(scene, bvh, cam);
+        const FrustumPlanes fp = worldFrustumPlanes(cam);
+        std::vector<uint32_t> brute;
+        uint64_t tests = 0;
+        for (uint32_t o = 0; o < scene.objects.size(); ++o) {
+            uint32_t mask = 0x3F;
+            if (classifySphere(fp, scene.objects[o].sphere, &mask, &tests) >= 0) brute.push_back(o);
+        }
+        EXPECT_EQ(f.visible, brute);
+        EXPECT_EQ(f.stats.objectsCulled + f.stats.objectsInside + f.stats.objectsIntersecting, 400u);
+        EXPECT_LT(f.stats.planeTests, f.stats.planeTestsBruteForce);
+    }
+}
+
+TEST(Frustum, ObjectsBehindAndBesideTheCameraAreCulledInTheDemo) {
+    const Scene scene = demoScene();
+    const ViewResult r = run(scene, scene.views[0]);
+    ASSERT_EQ(scene.views[0].name, "spawn");
+    const PreparedScene ps = prepareScene(scene);
+    const FrustumResult f = cullFrustum(scene, ps.bvh, r.camera);
+    auto visible = [&](const std::string &src) {
+        for (uint32_t o : f.visible)
+            if (scene.sources[scene.objects[o].source].name == src) return true;
+        return false;
+    };
+    EXPECT_FALSE(visible("behind"));
+    EXPECT_FALSE(visible("offscreen"));
+    EXPECT_TRUE(visible("ball"));
+    EXPECT_TRUE(visible("wall"));
+    EXPECT_GT(r.clip.perPlane[kPlaneNear], 0u);      // the wall crosses the near plane
+    EXPECT_GT(r.backface.doubleSidedExempt, 0u);      // the banner
+    // The funnel is consistent: each stage's input is the previous stage's output.
+    EXPECT_EQ(stage(r, "backface").trianglesIn, stage(r, "frustum").trianglesOut);
+    EXPECT_EQ(stage(r, "clip").trianglesIn, stage(r, "backface").trianglesOut);
+    EXPECT_EQ(stage(r, "zbuffer").trianglesIn, stage(r, "clip").trianglesOut);
+    EXPECT_FALSE(stage(r, "cells").ran);
+}
+
+TEST(Pipeline, CountsAndImagesAreIdenticalAcrossThreadCounts) {
+    const Scene scene = demoScene();
+    std::vector<AnalysisResult> results(3);
+    const int threads[3] = {1, 2, 8};
+    for (int k = 0; k < 3; ++k) {
+        PipelineSettings s;
+        s.threads = threads[k];
+        std::string err;
+        ASSERT_TRUE(analyzeScene(scene, scene.views, s, nullptr, &results[k], &err)) << err;
+    }
+    for (int k = 1; k < 3; ++k)
+        for (size_t v = 0; v < scene.views.size(); ++v) {
+            EXPECT_EQ(results[k].views[v].buffer.id, results[0].views[v].buffer.id);
+            EXPECT_EQ(results[k].views[v].buffer.depth, results[0].views[v].buffer.depth);
+            EXPECT_EQ(results[k].views[v].zbuffer.fragments, results[0].views[v].zbuffer.fragments);
+            EXPECT_EQ(results[k].views[v].zbuffer.histogram, results[0].views[v].zbuffer.histogram);
+        }
+}
+
+TEST(Pipeline, InvalidViewsAreRefusedBeforeAnyWork) {
+    const Scene scene = demoScene();
+    PipelineSettings s;
+    ViewSpec v = scene.views[0];
+    ViewSpec out;
+    Camera cam;
+    std::string err;
+    v.camera.width = 100000;
+    EXPECT_FALSE(resolveView(v, s, &out, &cam, &err));
+    EXPECT_EQ(err, "view 'spawn': resolution 100000x540 exceeds the limit of 16384 pixels per side; lower it "
+                   "(--width/--height) or raise the limit with --max-resolution");
+    v = scene.views[0];
+    v.camera.nearZ = 0;
+    EXPECT_FALSE(resolveView(v, s, &out, &cam, &err));
+    EXPECT_EQ(err, "view 'spawn': \"near\" must be > 0 (perspective depth is undefined at the eye); try 0.1");
+    v = scene.views[0];
+    v.camera.farZ = v.camera.nearZ;
+    EXPECT_FALSE(resolveView(v, s, &out, &cam, &err));
+    EXPECT_EQ(err, "view 'spawn': \"far\" must be greater than \"near\"; try far = 1000 * near");
+    v = scene.views[0];
+    v.camera.eye.x = std::nan("");
+    EXPECT_FALSE(resolveView(v, s, &out, &cam, &err));
+    EXPECT_EQ(err, "view 'spawn': \"eye\" is not finite; give three finite numbers");
+}
