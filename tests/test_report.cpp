@@ -1,0 +1,706 @@
+// report.json against docs/report-schema.json, exact JSON values of a synthetic result, image
+// files read back through OpenImageIO, the bitmap font and the console funnel table.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "reports/console.h"
+#include "reports/font.h"
+#include "reports/report.h"
+
+namespace va {
+namespace {
+
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+
+// ---- A small JSON Schema validator (the subset docs/report-schema.json uses) ------------------
+// Keywords: $ref (local "#/$defs/NAME"), type (string or array), const, enum, minimum, required,
+// properties, additionalProperties (false or a schema), items, minItems, maxItems.
+
+bool typeMatches(const std::string &t, const Json &v) {
+    if (t == "object") return v.is_object();
+    if (t == "array") return v.is_array();
+    if (t == "string") return v.is_string();
+    if (t == "boolean") return v.is_boolean();
+    if (t == "null") return v.is_null();
+    if (t == "integer") return v.is_number_integer();
+    if (t == "number") return v.is_number();
+    ADD_FAILURE() << "schema uses unknown type '" << t << "'";
+    return false;
+}
+
+void validate(const Json &root, const Json &schema, const Json &v, const std::string &where,
+              std::vector<std::string> *errors) {
+    static const std::vector<std::string> kKnown = {
+        "$schema", "$id", "title", "description", "$ref", "type", "const", "enum", "minimum", "required",
+        "properties", "additionalProperties", "items", "minItems", "maxItems", "$defs"};
+    for (auto it = schema.begin(); it != schema.end(); ++it)
+        if (std::find(kKnown.begin(), kKnown.end(), it.key()) == kKnown.end())
+            errors->push_back(where + ": validator does not know keyword '" + it.key() + "'");
+    if (schema.contains("$ref")) {
+        const std::string ref = schema["$ref"];
+        const std::string prefix = "#/$defs/";
+        if (ref.rfind(prefix, 0) != 0 || !root["$defs"].contains(ref.substr(prefix.size()))) {
+            errors->push_back(where + ": unresolvable $ref " + ref);
+            return;
+        }
+        validate(root, root["$defs"][ref.substr(prefix.size())], v, where, errors);
+    }
+    if (schema.contains("type")) {
+        bool ok = false;
+        if (schema["type"].is_string()) ok = typeMatches(schema["type"], v);
+        else
+            for (const auto &t : schema["type"]) ok = ok || typeMatches(t, v);
+        if (!ok) {
+            errors->push_back(where + ": expected type " + schema["type"].dump() + ", got " + v.dump());
+            return;
+        }
+    }
+    if (schema.contains("const") && v != schema["const"])
+        errors->push_back(where + ": expected " + schema["const"].dump() + ", got " + v.dump());
+    if (schema.contains("enum") && std::find(schema["enum"].begin(), schema["enum"].end(), v) == schema["enum"].end())
+        errors->push_back(where + ": " + v.dump() + " not in enum");
+    if (schema.contains("minimum") && v.is_number() && v.get<double>() < schema["minimum"].get<double>())
+        errors->push_back(where + ": " + v.dump() + " below minimum");
+    if (v.is_object()) {
+        if (schema.contains("required"))
+            for (const auto &r : schema["required"])
+                if (!v.contains(r.get<std::string>())) errors->push_back(where + ": missing required '" + r.get<std::string>() + "'");
+        for (auto it = v.begin(); it != v.end(); ++it) {
+            const std::string at = where + "/" + it.key();
+            if (schema.contains("properties") && schema["properties"].contains(it.key()))
+                validate(root, schema["properties"][it.key()], it.value(), at, errors);
+            else if (schema.contains("additionalProperties")) {
+                const Json &ap = schema["additionalProperties"];
+                if (ap.is_boolean() && !ap.get<bool>()) errors->push_back(at + ": property not allowed by the schema");
+                else if (ap.is_object()) validate(root, ap, it.value(), at, errors);
+            }
+        }
+    }
+    if (v.is_array()) {
+        if (schema.contains("minItems") && v.size() < schema["minItems"].get<size_t>())
+            errors->push_back(where + ": fewer than minItems");
+        if (schema.contains("maxItems") && v.size() > schema["maxItems"].get<size_t>())
+            errors->push_back(where + ": more than maxItems");
+        if (schema.contains("items"))
+            for (size_t i = 0; i < v.size(); ++i)
+                validate(root, schema["items"], v[i], where + "/" + std::to_string(i), errors);
+    }
+}
+
+std::vector<std::string> validateReport(const Json &schema, const Json &report) {
+    std::vector<std::string> errors;
+    validate(schema, schema, report, "", &errors);
+    return errors;
+}
+
+// Every schema a property, an item or a definition is described by must carry a description
+// (STYLE.md rule 2: every field says what it counts and its best value).
+void collectUndescribed(const Json &schema, const std::string &where, std::vector<std::string> *out) {
+    if (!schema.is_object()) return;
+    auto need = [&](const Json &s, const std::string &at) {
+        if (!s.is_object() || !s.contains("description") || !s["description"].is_string() ||
+            s["description"].get<std::string>().size() < 5)
+            out->push_back(at);
+        collectUndescribed(s, at, out);
+    };
+    if (schema.contains("properties"))
+        for (auto it = schema["properties"].begin(); it != schema["properties"].end(); ++it)
+            need(it.value(), where + "/properties/" + it.key());
+    if (schema.contains("items")) need(schema["items"], where + "/items");
+    if (schema.contains("additionalProperties") && schema["additionalProperties"].is_object())
+        need(schema["additionalProperties"], where + "/additionalProperties");
+    if (schema.contains("$defs"))
+        for (auto it = schema["$defs"].begin(); it != schema["$defs"].end(); ++it)
+            need(it.value(), where + "/$defs/" + it.key());
+}
+
+Json loadSchema() {
+    std::ifstream f(std::string(VISAUDIT_SOURCE_DIR) + "/docs/report-schema.json");
+    EXPECT_TRUE(f.good()) << "cannot open docs/report-schema.json";
+    return Json::parse(f);
+}
+
+// ---- A synthetic analysis result -------------------------------------------------------------
+
+StageRecord stage(const char *name, uint64_t in, uint64_t culled, uint64_t out, double ms) {
+    StageRecord s;
+    s.name = name;
+    s.ran = true;
+    s.trianglesIn = in;
+    s.trianglesCulled = culled;
+    s.trianglesOut = out;
+    s.ms = ms;
+    return s;
+}
+StageRecord skipped(const char *name, const char *reason) {
+    StageRecord s;
+    s.name = name;
+    s.reason = reason;
+    return s;
+}
+
+ViewResult spawnView() {
+    ViewResult v;
+    v.spec.name = "spawn";
+    v.spec.origin = "scene";
+    v.spec.depthFormat = DepthFormat::unorm24;
+    v.spec.camera.eye = {0, 1.5, 8};
+    v.spec.camera.target = {0, 1.5, 0};
+    v.spec.camera.fovYDegrees = 60;
+    v.spec.camera.nearZ = 0.25;
+    v.spec.camera.farZ = 500;
+    v.spec.camera.width = 4;
+    v.spec.camera.height = 3;
+    v.stages = {skipped("cells", "scene has no cells"), stage("grid", 1200, 200, 1000, 0.04),
+                stage("frustum", 1000, 400, 600, 0.25), skipped("occlusion", "no occluders selected"),
+                stage("backface", 600, 280, 320, 0.5), stage("clip", 320, 20, 310, 1.25),
+                stage("zbuffer", 310, 0, 310, 3.0)};
+    v.frustum = {40, 16, 20, 4, 31, 150, 240};
+    v.backface = {580, 280, 20, 3};
+    v.clip.trianglesIn = 320;
+    v.clip.trivialRejected = 18;
+    v.clip.inside = 250;
+    v.clip.guardBandAccepted = 40;
+    v.clip.clipped = 12;
+    v.clip.clippedAway = 2;
+    v.clip.edgeOn = 0;
+    v.clip.perPlane = {12, 1, 0, 0, 0, 2};
+    v.clip.polygonVertices = {0, 0, 0, 3, 6, 1, 0, 0, 0, 0};
+    v.clip.trianglesOut = 310;
+    v.zbuffer.trianglesIn = 310;
+    v.zbuffer.trianglesDrawn = 300;
+    v.zbuffer.trianglesEmpty = 10;
+    v.zbuffer.fragments = 15;
+    v.zbuffer.depthPasses = 12;
+    v.zbuffer.outOfRangeFragments = 1;
+    v.zbuffer.coveredPixels = 9;
+    v.zbuffer.overdraw = 12.0 / 9.0;
+    v.zbuffer.depthComplexity = 15.0 / 9.0;
+    v.zbuffer.maxDepthComplexity = 3;
+    v.zbuffer.histogram = {3, 5, 2, 2};
+    v.totalMs = 5.5;
+    return v;
+}
+
+ViewResult orthoView(const char *name) {
+    ViewResult v;
+    v.spec.name = name;
+    v.spec.origin = "views.json";
+    v.spec.depthFormat = DepthFormat::f32_reversed;
+    v.spec.camera.orthographic = true;
+    v.spec.camera.orthoHeight = 20;
+    v.spec.camera.eye = {0, 50, 0};
+    v.spec.camera.target = {0, 0, 0};
+    v.spec.camera.up = {0, 0, -1};
+    v.spec.camera.nearZ = 1;
+    v.spec.camera.farZ = 100;
+    v.spec.camera.width = 2;
+    v.spec.camera.height = 2;
+    v.stages = {skipped("cells", "scene has no cells"), stage("frustum", 1200, 100, 1100, 0.1),
+                skipped("backface", "disabled by --no-backface"), stage("zbuffer", 1100, 0, 1100, 0.5)};
+    v.frustum = {40, 2, 30, 8, 10, 60, 240};
+    v.zbuffer.fragments = 7;
+    v.zbuffer.depthPasses = 5;
+    v.zbuffer.coveredPixels = 4;
+    v.zbuffer.overdraw = 1.25;
+    v.zbuffer.depthComplexity = 1.75;
+    v.zbuffer.maxDepthComplexity = 2;
+    v.zbuffer.histogram = {0, 1, 3};
+    v.totalMs = 1.0;
+    return v;
+}
+
+AnalysisResult syntheticResult() {
+    AnalysisResult r;
+    r.scenePath = "examples/hall.scene.json";
+    r.sceneStats = {1210, 6, 4, 2, 17};
+    r.triangles = 1200;
+    r.objects = 40;
+    r.sourceObjects = 3;
+    r.bounds.lo = {-10, 0, -20};
+    r.bounds.hi = {10, 5.5, 20};
+    r.loadMs = 12.5;
+    r.views = {spawnView(), orthoView("Hall/East"), orthoView("hall_east"), orthoView(""), orthoView("..")};
+    return r;
+}
+
+// Drops every timing field ("ms", "*_ms") so that two reports can be compared for determinism.
+void stripTimes(Json &j) {
+    if (j.is_object()) {
+        std::vector<std::string> drop;
+        for (auto it = j.begin(); it != j.end(); ++it) {
+            const std::string &k = it.key();
+            if (k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0)) drop.push_back(k);
+            else stripTimes(it.value());
+        }
+        for (const auto &k : drop) j.erase(k);
+    } else if (j.is_array()) {
+        for (auto &e : j) stripTimes(e);
+    }
+}
+
+// ---- report.json -------------------------------------------------------------------------------
+
+TEST(ReportJson, ValidatesAgainstSchema) {
+    const Json schema = loadSchema();
+    const Json report = reportJson(syntheticResult());
+    const auto errors = validateReport(schema, report);
+    for (const auto &e : errors) ADD_FAILURE() << e;
+    EXPECT_TRUE(errors.empty());
+}
+
+TEST(ReportJson, EverySchemaFieldHasADescription) {
+    std::vector<std::string> missing;
+    collectUndescribed(loadSchema(), "", &missing);
+    for (const auto &m : missing) ADD_FAILURE() << "no description at " << m;
+    EXPECT_TRUE(missing.empty());
+}
+
+// The validator must be able to fail, or the test above proves nothing.
+TEST(ReportJson, ValidatorRejectsBrokenReports) {
+    const Json schema = loadSchema();
+    const Json good = reportJson(syntheticResult());
+    {
+        Json bad = good;
+        bad["views"][0]["stages"][2]["plane_testz"] = 3;  // a typo'd key
+        const auto e = validateReport(schema, bad);
+        ASSERT_EQ(e.size(), 1u);
+        EXPECT_EQ(e[0], "/views/0/stages/2/plane_testz: property not allowed by the schema");
+    }
+    {
+        Json bad = good;
+        bad["views"][1]["zbuffer"].erase("histogram");
+        const auto e = validateReport(schema, bad);
+        ASSERT_EQ(e.size(), 1u);
+        EXPECT_EQ(e[0], "/views/1/zbuffer: missing required 'histogram'");
+    }
+    {
+        Json bad = good;
+        bad["scene"]["triangles"] = -1;
+        bad["views"][0]["camera"]["eye"] = Json::array({1, 2});
+        bad["format"] = "visaudit-report/2";
+        EXPECT_EQ(validateReport(schema, bad).size(), 3u);
+    }
+    {
+        Json bad = good;
+        bad["views"][0]["zbuffer"]["overdraw"] = "1.3";
+        EXPECT_EQ(validateReport(schema, bad).size(), 1u);
+    }
+}
+
+TEST(ReportJson, ExactValues) {
+    const Json j = reportJson(syntheticResult());
+    EXPECT_EQ(j["format"], "visaudit-report/1");
+    EXPECT_EQ(j["tool"]["name"], "visaudit");
+    EXPECT_EQ(j["tool"]["version"], VISAUDIT_VERSION);
+
+    const Json &s = j["scene"];
+    EXPECT_EQ(s["path"], "examples/hall.scene.json");
+    EXPECT_EQ(s["triangles"], 1200);
+    EXPECT_EQ(s["source_triangles"], 1210);
+    EXPECT_EQ(s["objects"], 40);
+    EXPECT_EQ(s["source_objects"], 3);
+    EXPECT_EQ(s["degenerate_triangles"], 6);
+    EXPECT_EQ(s["non_finite_triangles"], 4);
+    EXPECT_EQ(s["faces_dropped"], 2);
+    EXPECT_EQ(s["polygons_triangulated"], 17);
+    EXPECT_EQ(s["bounds"].dump(), R"({"min":[-10.0,0.0,-20.0],"max":[10.0,5.5,20.0]})");
+    EXPECT_EQ(j["load_ms"], 12.5);
+
+    ASSERT_EQ(j["views"].size(), 5u);
+    const Json &v = j["views"][0];
+    EXPECT_EQ(v["name"], "spawn");
+    EXPECT_EQ(v["width"], 4);
+    EXPECT_EQ(v["height"], 3);
+    EXPECT_EQ(v["depth_format"], "unorm24");
+    EXPECT_EQ(v["projection"], "perspective");
+    EXPECT_EQ(v["camera"].dump(),
+              R"({"eye":[0.0,1.5,8.0],"target":[0.0,1.5,0.0],"up":[0.0,1.0,0.0],"fov_y":60.0,"near":0.25,"far":500.0})");
+
+    // The funnel: skipped stages carry a reason and no counts of their own.
+    const Json &st = v["stages"];
+    ASSERT_EQ(st.size(), 7u);
+    EXPECT_EQ(st[0].dump(),
+              R"({"name":"cells","ran":false,"reason":"scene has no cells","triangles_in":0,"triangles_culled":0,"triangles_out":0,"ms":0.0})");
+    EXPECT_EQ(st[1].dump(),
+              R"({"name":"grid","ran":true,"triangles_in":1200,"triangles_culled":200,"triangles_out":1000,"ms":0.04})");
+    EXPECT_EQ(st[2].dump(),
+              R"({"name":"frustum","ran":true,"triangles_in":1000,"triangles_culled":400,"triangles_out":600,"ms":0.25,)"
+              R"("objects_in":40,"objects_culled":16,"objects_inside":20,"objects_intersecting":4,"nodes_visited":31,)"
+              R"("plane_tests":150,"plane_tests_brute_force":240})");
+    EXPECT_FALSE(st[3]["ran"]);
+    EXPECT_EQ(st[3]["reason"], "no occluders selected");
+    EXPECT_EQ(st[4].dump(),
+              R"({"name":"backface","ran":true,"triangles_in":600,"triangles_culled":280,"triangles_out":320,"ms":0.5,)"
+              R"("triangles_tested":580,"double_sided_exempt":20,"edge_on":3})");
+    EXPECT_EQ(st[5].dump(),
+              R"({"name":"clip","ran":true,"triangles_in":320,"triangles_culled":20,"triangles_out":310,"ms":1.25,)"
+              R"("trivially_rejected":18,"inside":250,"guard_band_accepted":40,"clipped":12,"clipped_away":2,"edge_on":0,)"
+              R"("per_plane":{"near":12,"far":1,"left":0,"right":0,"bottom":0,"top":2},)"
+              R"("polygon_vertices":{"3":3,"4":6,"5":1,"6":0,"7":0,"8":0,"9+":0}})");
+    EXPECT_EQ(st[6].dump(),
+              R"({"name":"zbuffer","ran":true,"triangles_in":310,"triangles_culled":0,"triangles_out":310,"ms":3.0,)"
+              R"("triangles_drawn":300,"triangles_empty":10,"fragments":15,"depth_passes":12,"out_of_range_fragments":1})");
+
+    const Json &z = v["zbuffer"];
+    EXPECT_EQ(z["covered_pixels"], 9);
+    EXPECT_EQ(z["fragments"], 15);
+    EXPECT_EQ(z["depth_passes"], 12);
+    EXPECT_EQ(z["overdraw"], 12.0 / 9.0);
+    EXPECT_EQ(z["depth_complexity"], 15.0 / 9.0);
+    EXPECT_EQ(z["max_depth_complexity"], 3);
+    EXPECT_EQ(z["histogram"].dump(), "[3,5,2,2]");
+    EXPECT_EQ(v["images"].dump(),
+              R"({"depth_exr":"spawn.depth.exr","depth_png":"spawn.depth.png","overdraw_png":"spawn.overdraw.png","ids_exr":"spawn.ids.exr"})");
+    EXPECT_EQ(v["total_ms"], 5.5);
+
+    // Orthographic camera: ortho_height instead of fov_y.
+    EXPECT_EQ(j["views"][1]["projection"], "orthographic");
+    EXPECT_EQ(j["views"][1]["camera"]["ortho_height"], 20.0);
+    EXPECT_FALSE(j["views"][1]["camera"].contains("fov_y"));
+    EXPECT_EQ(j["views"][1]["depth_format"], "f32_reversed");
+
+    // Sanitized, disambiguated image names: '/' -> '_'; "hall_east" collides with "Hall_East"
+    // case-insensitively and gets "-2"; "" -> "view"; ".." -> "_." (no leading dot).
+    EXPECT_EQ(j["views"][1]["name"], "Hall/East");
+    EXPECT_EQ(j["views"][1]["images"]["depth_exr"], "Hall_East.depth.exr");
+    EXPECT_EQ(j["views"][2]["images"]["depth_png"], "hall_east-2.depth.png");
+    EXPECT_EQ(j["views"][3]["images"]["overdraw_png"], "view.overdraw.png");
+    EXPECT_EQ(j["views"][4]["images"]["ids_exr"], "_..ids.exr");
+
+    // Totals: culled per stage summed over the 5 views (grid only in view 0; frustum 400 + 4 x 100).
+    const Json &t = j["totals"];
+    EXPECT_EQ(t["views"], 5);
+    EXPECT_EQ(t["triangles_culled"].dump(),
+              R"({"cells":0,"grid":200,"frustum":800,"occlusion":0,"backface":280,"clip":20,"zbuffer":0})");
+    EXPECT_EQ(t["covered_pixels"], 9 + 4 * 4);
+    EXPECT_EQ(t["fragments"], 15 + 4 * 7);
+    EXPECT_EQ(t["depth_passes"], 12 + 4 * 5);
+    EXPECT_EQ(t["total_ms"], 5.5 + 4 * 1.0);
+}
+
+TEST(ReportJson, DeterministicApartFromTimes) {
+    AnalysisResult a = syntheticResult(), b = syntheticResult();
+    EXPECT_EQ(reportJson(a).dump(2), reportJson(b).dump(2));
+    b.loadMs = 99;
+    b.views[0].stages[2].ms = 7.25;
+    b.views[1].totalMs = 3;
+    Json ja = reportJson(a), jb = reportJson(b);
+    EXPECT_NE(ja.dump(), jb.dump());
+    stripTimes(ja);
+    stripTimes(jb);
+    EXPECT_EQ(ja.dump(2), jb.dump(2));
+    // A count change is not masked by stripping times.
+    b.views[0].frustum.planeTests = 151;
+    jb = reportJson(b);
+    stripTimes(jb);
+    EXPECT_NE(ja.dump(), jb.dump());
+}
+
+TEST(ReportJson, NonFiniteNumbersBecomeNull) {
+    AnalysisResult r = syntheticResult();
+    r.bounds = Aabb{};  // empty scene: lo = +inf, hi = -inf
+    r.views[0].zbuffer.overdraw = std::numeric_limits<double>::quiet_NaN();
+    r.views[0].zbuffer.depthComplexity = std::numeric_limits<double>::infinity();
+    const Json j = reportJson(r);
+    EXPECT_TRUE(j["scene"]["bounds"]["min"].is_null());
+    EXPECT_TRUE(j["scene"]["bounds"]["max"].is_null());
+    EXPECT_TRUE(j["views"][0]["zbuffer"]["overdraw"].is_null());
+    EXPECT_TRUE(j["views"][0]["zbuffer"]["depth_complexity"].is_null());
+    EXPECT_EQ(j.dump().find("NaN"), std::string::npos);
+    EXPECT_TRUE(validateReport(loadSchema(), j).empty());
+}
+
+TEST(ReportJson, EmptyResult) {
+    const Json j = reportJson(AnalysisResult{});
+    EXPECT_EQ(j["views"].dump(), "[]");
+    EXPECT_EQ(j["totals"].dump(),
+              R"({"views":0,"triangles_culled":{},"covered_pixels":0,"fragments":0,"depth_passes":0,"total_ms":0.0})");
+    EXPECT_TRUE(validateReport(loadSchema(), j).empty());
+}
+
+TEST(ReportNames, Sanitize) {
+    EXPECT_EQ(sanitizeFileName("spawn"), "spawn");
+    EXPECT_EQ(sanitizeFileName("a-b_c.D9"), "a-b_c.D9");
+    EXPECT_EQ(sanitizeFileName("../../etc/passwd"), "_._.._etc_passwd");
+    EXPECT_EQ(sanitizeFileName("hall east:1"), "hall_east_1");
+    EXPECT_EQ(sanitizeFileName("caf\xC3\xA9"), "caf__");  // two UTF-8 bytes, two '_'
+    EXPECT_EQ(sanitizeFileName(""), "view");
+    EXPECT_EQ(sanitizeFileName(".hidden"), "_hidden");
+    EXPECT_EQ(sanitizeFileName(std::string(300, 'a')), std::string(kMaxImageBaseName, 'a'));
+}
+
+TEST(ReportNames, CollisionsResolvedInViewOrder) {
+    std::vector<ViewResult> views(6);
+    const char *names[] = {"a b", "a_b", "A_B", "a_b-2", "x", "a?b"};
+    for (int i = 0; i < 6; ++i) views[size_t(i)].spec.name = names[i];
+    const std::vector<std::string> expected = {"a_b", "a_b-2", "A_B-3", "a_b-2-2", "x", "a_b-4"};
+    EXPECT_EQ(imageBaseNames(views), expected);
+}
+
+// ---- Images ------------------------------------------------------------------------------------
+
+struct TempDir {
+    std::string path;
+    TempDir() {
+        std::string t = (fs::temp_directory_path() / "visaudit-report-XXXXXX").string();
+        path = ::mkdtemp(t.data()) ? t : "";
+    }
+    ~TempDir() {
+        std::error_code ec;
+        if (!path.empty()) fs::remove_all(path, ec);
+    }
+};
+
+// A 4 x 3 view:
+//   depth      1      10     1000    inf          fragments  1  5  9  0        ids  1  2  0xFFFFFFF0  0
+//              10     0.1f*  inf     inf                     2  3  0  0             3  4  0           0
+//              1000   1      1      10                      1  1  1  1             5  6  7           8
+// (* the double nearest 0.1, written to EXR as float(0.1); it is the view's minimum depth).
+ViewResult imageView() {
+    ViewResult v;
+    v.spec.name = "img test";
+    const double inf = std::numeric_limits<double>::infinity();
+    v.buffer.width = 4;
+    v.buffer.height = 3;
+    v.buffer.depth = {1, 10, 1000, inf, 10, 0.1, inf, inf, 1000, 1, 1, 10};
+    v.buffer.fragments = {1, 5, 9, 0, 2, 3, 0, 0, 1, 1, 1, 1};
+    v.buffer.id = {1, 2, 0xFFFFFFF0u, 0, 3, 4, 0, 0, 5, 6, 7, 8};
+    v.buffer.key.assign(12, 0);
+    v.buffer.passes.assign(12, 1);
+    return v;
+}
+
+std::vector<uint8_t> rgbAt(const ImageData &im, int x, int y) {
+    const size_t i = (size_t(y) * size_t(im.width) + size_t(x)) * 3;
+    return {im.u8[i], im.u8[i + 1], im.u8[i + 2]};
+}
+using Px = std::vector<uint8_t>;
+
+TEST(ReportImages, ColorMappings) {
+    // Overdraw ramp, cap 9: t = (v - 1) / 8. v = 5 -> t = 0.5, exactly the green stop.
+    EXPECT_EQ(overdrawColor(0, 9), (Rgb8{0, 0, 0}));
+    EXPECT_EQ(overdrawColor(1, 9), (Rgb8{32, 64, 255}));
+    EXPECT_EQ(overdrawColor(5, 9), (Rgb8{48, 220, 48}));
+    EXPECT_EQ(overdrawColor(9, 9), (Rgb8{255, 255, 255}));
+    EXPECT_EQ(overdrawColor(200, 9), (Rgb8{255, 255, 255}));  // above the cap: top color
+    // v = 2 of 9: t = 0.125, halfway from blue (32,64,255) to cyan (0,200,255): (16, 132, 255).
+    EXPECT_EQ(overdrawColor(2, 9), (Rgb8{16, 132, 255}));
+    // Depth gray, dMin 1, dMax 1000: 10 is a third of the way in log scale: 255 - 215/3 = 183.3.
+    EXPECT_EQ(depthGray(1, 1, 1000), 255);
+    EXPECT_EQ(depthGray(10, 1, 1000), 183);
+    EXPECT_EQ(depthGray(1000, 1, 1000), kDepthPngFarGray);
+    EXPECT_EQ(depthGray(std::numeric_limits<double>::infinity(), 1, 1000), 0);
+    EXPECT_EQ(depthGray(5, 5, 5), 255);  // one depth only: white
+}
+
+TEST(ReportImages, WriteAndReadBack) {
+    TempDir dir;
+    ASSERT_FALSE(dir.path.empty());
+    const ViewResult v = imageView();
+    std::string err;
+    ASSERT_TRUE(writeViewImages(v, dir.path, "img_test", &err)) << err;
+
+    // Only the four images remain (temporaries renamed away).
+    std::vector<std::string> files;
+    for (const auto &e : fs::directory_iterator(dir.path)) files.push_back(e.path().filename().string());
+    std::sort(files.begin(), files.end());
+    EXPECT_EQ(files, (std::vector<std::string>{"img_test.depth.exr", "img_test.depth.png", "img_test.ids.exr",
+                                               "img_test.overdraw.png"}));
+
+    // depth.exr: one float channel "Z", bit-exactly float(depth), +inf background.
+    ImageData z;
+    ASSERT_TRUE(readImage(dir.path + "/img_test.depth.exr", &z, &err)) << err;
+    EXPECT_EQ(z.width, 4);
+    EXPECT_EQ(z.height, 3);
+    EXPECT_EQ(z.channelNames, std::vector<std::string>{"Z"});
+    EXPECT_EQ(z.pixelType, "float");
+    ASSERT_EQ(z.f32.size(), 12u);
+    for (size_t i = 0; i < 12; ++i) {
+        const float expected = float(v.buffer.depth[i]);
+        EXPECT_EQ(std::memcmp(&z.f32[i], &expected, sizeof(float)), 0) << "pixel " << i << ": " << z.f32[i];
+    }
+    EXPECT_TRUE(std::isinf(z.f32[3]) && z.f32[3] > 0);
+
+    // ids.exr: one UINT32 channel "id", exact (0xFFFFFFF0 would not survive a float channel).
+    ImageData ids;
+    ASSERT_TRUE(readImage(dir.path + "/img_test.ids.exr", &ids, &err)) << err;
+    EXPECT_EQ(ids.channelNames, std::vector<std::string>{"id"});
+    EXPECT_EQ(ids.pixelType, "uint");
+    EXPECT_EQ(ids.u32, v.buffer.id);
+
+    // depth.png: gray, dMin = 0.1, dMax = 1000 (4 decades): 1 -> t = 1/4 -> 255 - 53.75 = 201.25;
+    // 10 -> t = 1/2 -> 147.5 computed in floating point; the exact mapping is depthGray.
+    ImageData g;
+    ASSERT_TRUE(readImage(dir.path + "/img_test.depth.png", &g, &err)) << err;
+    EXPECT_EQ(g.width, 4);
+    EXPECT_EQ(g.height, 3);
+    ASSERT_EQ(g.channels(), 1);
+    ASSERT_EQ(g.u8.size(), 12u);
+    EXPECT_EQ(g.u8[5], 255);               // 0.1: nearest, white
+    EXPECT_EQ(g.u8[0], 201);               // 1.0
+    EXPECT_EQ(g.u8[2], kDepthPngFarGray);  // 1000: farthest
+    EXPECT_EQ(g.u8[3], 0);                 // background
+    for (size_t i = 0; i < 12; ++i) EXPECT_EQ(g.u8[i], depthGray(v.buffer.depth[i], 0.1, 1000)) << i;
+
+    // overdraw.png: cap = max(8, 9) = 9, legend values 0..9 (10 swatches). Layout at scale 1:
+    //   cell width = max(label width 5, 7) + 2 = 9; legend width = 10 * 9 - 2 = 88;
+    //   canvas width = max(4, 88 + 2 * 3) = 94; strip height = 3 + 6 + 2 + 7 + 3 = 21 -> 3 + 21 = 24.
+    ImageData o;
+    ASSERT_TRUE(readImage(dir.path + "/img_test.overdraw.png", &o, &err)) << err;
+    EXPECT_EQ(o.width, 94);
+    EXPECT_EQ(o.height, 24);
+    ASSERT_EQ(o.channels(), 3);
+    EXPECT_EQ(rgbAt(o, 0, 0), (Px{32, 64, 255}));     // 1 fragment: blue
+    EXPECT_EQ(rgbAt(o, 1, 0), (Px{48, 220, 48}));     // 5: green
+    EXPECT_EQ(rgbAt(o, 2, 0), (Px{255, 255, 255}));   // 9: white
+    EXPECT_EQ(rgbAt(o, 3, 0), (Px{0, 0, 0}));         // 0: black
+    EXPECT_EQ(rgbAt(o, 0, 1), (Px{16, 132, 255}));    // 2
+    EXPECT_EQ(rgbAt(o, 4, 0), (Px{24, 24, 24}));      // canvas widened right of the image: strip color
+    EXPECT_EQ(rgbAt(o, 0, 3), (Px{24, 24, 24}));      // strip below the image
+    // Legend: x0 = 94 - 3 - 88 = 3, swatches at y 6..11 (outline) with interior y 7..10.
+    EXPECT_EQ(rgbAt(o, 3, 6), (Px{160, 160, 160}));   // swatch "0" outline
+    EXPECT_EQ(rgbAt(o, 5, 8), (Px{0, 0, 0}));         // swatch "0" interior
+    EXPECT_EQ(rgbAt(o, 3 + 9 + 3, 8), (Px{32, 64, 255}));       // swatch "1"
+    EXPECT_EQ(rgbAt(o, 3 + 9 * 9 + 3, 8), (Px{255, 255, 255})); // swatch "9"
+    // Label "0" at x = 3 + (7 - 5) / 2 = 4, y = 6 + 6 + 2 = 14: glyph row 0 is .###. -> x 5..7.
+    EXPECT_EQ(rgbAt(o, 4, 14), (Px{24, 24, 24}));
+    EXPECT_EQ(rgbAt(o, 5, 14), (Px{255, 255, 255}));
+    EXPECT_EQ(rgbAt(o, 7, 14), (Px{255, 255, 255}));
+    EXPECT_EQ(rgbAt(o, 8, 14), (Px{24, 24, 24}));
+}
+
+TEST(ReportImages, LargeImageKeepsWidthAndScalesLegend) {
+    TempDir dir;
+    ViewResult v;
+    v.spec.name = "wide";
+    v.buffer.width = 1100;
+    v.buffer.height = 2;
+    const size_t n = 2200;
+    v.buffer.depth.assign(n, 2.0);
+    v.buffer.id.assign(n, 1);
+    v.buffer.fragments.assign(n, 1);
+    v.buffer.fragments[0] = 40;  // cap 40 -> 0, 1 and 8 spaced values (6, 11, ..., 40)
+    std::string err;
+    ASSERT_TRUE(writeViewImages(v, dir.path, &err)) << err;
+    ImageData o;
+    ASSERT_TRUE(readImage(dir.path + "/wide.overdraw.png", &o, &err)) << err;
+    EXPECT_EQ(o.width, 1100);     // the legend fits: the canvas keeps the image width
+    EXPECT_EQ(o.height, 2 + 42);  // scale 2 for images 1024+ wide: strip 21 * 2
+    EXPECT_EQ(rgbAt(o, 0, 0), (Px{255, 255, 255}));
+    EXPECT_EQ(rgbAt(o, 1, 0), (Px{32, 64, 255}));
+}
+
+TEST(ReportImages, Errors) {
+    TempDir dir;
+    std::string err;
+    const std::string missing = dir.path + "/no/such/folder";
+    EXPECT_FALSE(writeViewImages(imageView(), missing, "x", &err));
+    EXPECT_NE(err.find("cannot write image '" + missing + "/x.depth.exr'"), std::string::npos) << err;
+
+    ViewResult released = imageView();
+    released.buffer = ZBuffer{};
+    EXPECT_FALSE(writeViewImages(released, dir.path, &err));
+    EXPECT_EQ(err, "view 'img test': no per-pixel buffers of 0x0 pixels to write images from (were they released "
+                   "before writing?)");
+    EXPECT_TRUE(fs::is_empty(dir.path));
+
+    ImageData d;
+    EXPECT_FALSE(readImage(dir.path + "/absent.exr", &d, &err));
+    EXPECT_NE(err.find(dir.path + "/absent.exr"), std::string::npos) << err;
+}
+
+TEST(ReportImages, AllViewsUseDisambiguatedNames) {
+    TempDir dir;
+    AnalysisResult r;
+    r.views = {imageView(), imageView()};
+    r.views[1].spec.name = "img_test";  // sanitized, "img test" is "img_test" too
+    std::string err;
+    ASSERT_TRUE(writeAllViewImages(r, dir.path, &err)) << err;
+    const Json j = reportJson(r);
+    for (const auto &v : j["views"])
+        for (const auto &f : v["images"]) EXPECT_TRUE(fs::exists(dir.path + "/" + f.get<std::string>())) << f;
+    EXPECT_EQ(j["views"][1]["images"]["ids_exr"], "img_test-2.ids.exr");
+}
+
+// ---- Font --------------------------------------------------------------------------------------
+
+TEST(ReportFont, DrawsGlyphCells) {
+    const int w = 20, h = 16;
+    std::vector<uint8_t> img(w * h * 3, 0);
+    const int end = drawText(img.data(), w, h, 1, 1, "1", {255, 0, 0}, 2);
+    EXPECT_EQ(end, 1 + 10);
+    // '1' row 0 = ..#.. : column 2 -> pixels x 1 + 4 .. 1 + 5, y 1 .. 2 at scale 2.
+    auto red = [&](int x, int y) { return img[(y * w + x) * 3] == 255 && img[(y * w + x) * 3 + 1] == 0; };
+    EXPECT_TRUE(red(5, 1) && red(6, 1) && red(5, 2) && red(6, 2));
+    EXPECT_FALSE(red(4, 1));
+    EXPECT_FALSE(red(7, 1));
+    // Bottom row 6 = .###. -> x 3 .. 8, y 13 .. 14.
+    EXPECT_TRUE(red(3, 13) && red(8, 14));
+    EXPECT_FALSE(red(2, 13));
+    int set = 0;
+    for (int i = 0; i < w * h; ++i) set += img[size_t(i) * 3] == 255;
+    EXPECT_EQ(set, (1 + 2 + 1 + 1 + 1 + 1 + 3) * 4);  // cells of '1' times 2x2
+}
+
+TEST(ReportFont, MetricsCaseAndMissingGlyphs) {
+    EXPECT_EQ(textWidth("", 1), 0);
+    EXPECT_EQ(textWidth("10", 1), 11);
+    EXPECT_EQ(textWidth("10", 3), 33);
+    EXPECT_TRUE(hasGlyph('a'));
+    EXPECT_TRUE(hasGlyph('Z'));
+    EXPECT_TRUE(hasGlyph('%'));
+    EXPECT_FALSE(hasGlyph('~'));
+    // Lower case draws the upper-case glyph.
+    std::vector<uint8_t> a(6 * 7 * 3, 0), b(6 * 7 * 3, 0), box(6 * 7 * 3, 0);
+    drawText(a.data(), 6, 7, 0, 0, "k", {9, 9, 9});
+    drawText(b.data(), 6, 7, 0, 0, "K", {9, 9, 9});
+    EXPECT_EQ(a, b);
+    // A missing glyph is a hollow 5x7 box: 5 + 5 + 2 * 5 = 20 cells.
+    drawText(box.data(), 6, 7, 0, 0, "~", {9, 9, 9});
+    int set = 0;
+    for (size_t i = 0; i < box.size(); i += 3) set += box[i] == 9;
+    EXPECT_EQ(set, 20);
+    // Drawing outside the image is clipped, not a crash.
+    drawText(box.data(), 6, 7, -3, 5, "888", {1, 1, 1}, 4);
+    drawText(box.data(), 6, 7, 100, 100, "8", {1, 1, 1});
+}
+
+// ---- Console -----------------------------------------------------------------------------------
+
+TEST(ReportConsole, FunnelTable) {
+    const std::string expected =
+        "view 'spawn' 4x3 unorm24 perspective\n"
+        "  stage      status      tris in      culled         out        ms\n"
+        "  cells      skipped scene has no cells\n"
+        "  grid       ran            1200         200        1000       0.0\n"
+        "  frustum    ran            1000         400         600       0.2\n"
+        "  occlusion  skipped no occluders selected\n"
+        "  backface   ran             600         280         320       0.5\n"
+        "  clip       ran             320          20         310       1.2\n"
+        "  zbuffer    ran             310           0         310       3.0\n"
+        "  zbuffer: 9 covered pixels, overdraw 1.33, depth complexity 1.67 (max 3)\n";
+    EXPECT_EQ(funnelTable(spawnView()), expected);
+}
+
+TEST(ReportConsole, WideNumbersAndNonFinite) {
+    ViewResult v = orthoView("top");
+    v.stages = {stage("frustum", 123456789012ull, 1, 123456789011ull, 1234.56)};
+    v.zbuffer.overdraw = std::numeric_limits<double>::quiet_NaN();
+    const std::string t = funnelTable(v);
+    EXPECT_NE(t.find("  frustum    ran     123456789012           1 123456789011    1234.6\n"), std::string::npos) << t;
+    EXPECT_NE(t.find("overdraw n/a, depth complexity 1.75 (max 2)"), std::string::npos) << t;
+}
+
+}  // namespace
+}  // namespace va
