@@ -17,10 +17,15 @@ inline uint32_t floatBits(float v) {
     return u;
 }
 
-// Clamps d into [lo, hi]; sets oor when it had to.
+// Clamps d into [lo, hi]; sets oor when it had to. d == lo returns lo itself, so d = -0.0 with
+// lo = 0 encodes as +0.0 (a float key of -0.0 would sort after every positive depth). A NaN depth
+// is out of range and clamped to the far end (never reaches an integer conversion).
 inline double clampDepth(double d, double lo, double hi, bool &oor) {
-    if (d < lo) { oor = true; return lo; }
-    if (d > hi) { oor = true; return hi; }
+    if (d <= lo) {
+        if (d < lo) oor = true;
+        return lo;
+    }
+    if (!(d <= hi)) { oor = true; return hi; }
     return d;
 }
 

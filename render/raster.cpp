@@ -1,0 +1,277 @@
+// The z-buffer rasterizer (raster.h; decisions in docs/rasterizer.md).
+//
+// Structure: rasterize() clears the buffers, then dispatches once on (depth format, projection) to
+// rasterizeTriangles<F, kPerspective>, whose per-fragment depth encoding is therefore inlined and
+// branch-free. Per triangle:
+//   1. orientation: twice the signed area in fixed point; zero -> empty, negative -> swap v1, v2 so
+//      every triangle is walked with the same winding and the same inside test;
+//   2. the bounding box of the *pixel centers* it may cover, clamped to the viewport; empty box ->
+//      done (the common case for the benchmark scene's sub-pixel triangles: no edge setup at all);
+//   3. edge functions in int64 at the first center, stepped exactly by integer increments;
+//   4. narrow boxes scan every center of the box; wide boxes solve each row's covered span with
+//      integer floor division (exact, the same inequalities), so large triangles cost per row,
+//      not per empty center of their box;
+//   5. per covered center: view depth straight from the DepthPlane (never stepped), encode, LESS.
+#include "render/raster.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "render/depth_format_impl.h"
+
+namespace va {
+
+int32_t toFixed(double pixelCoordinate) {
+    // Scaling by 2^kSubpixelBits is exact; nearbyint rounds half to even in the default mode.
+    const double s = std::nearbyint(pixelCoordinate * kSubpixelOne);
+    // Saturate (NaN goes to the minimum): the rasterizer rejects such coordinates (kMaxFixed below).
+    if (!(s > -2147483648.0)) return std::numeric_limits<int32_t>::min();
+    if (s > 2147483647.0) return std::numeric_limits<int32_t>::max();
+    return int32_t(s);
+}
+
+namespace {
+
+// Range of fixed-point coordinates the int64 edge functions hold without overflow. With
+// |x|, |y| <= 2^29 every vertex difference is below 2^30 + 2^29 < 2^31, each product of two
+// differences below 2^62, and the edge function (difference of two products, plus the bias) below
+// 2^63. That is 2^21 pixels (2 million) outside the viewport, far beyond the clipper's guard band
+// (ClipSettings::guardBandPixels = 8192, i.e. 2^21 in fixed point). Triangles beyond it violate the
+// clip stage's contract; they are skipped and counted as empty rather than risk a wrapped sign.
+constexpr int64_t kMaxFixed = int64_t(1) << 29;
+
+// Pixel x's sample (center) in fixed point is x * kSubpixelOne + kHalf.
+constexpr int64_t kHalf = kSubpixelOne / 2;
+
+// Boxes at least this many pixels wide use the per-row span solver instead of scanning centers.
+constexpr int64_t kSpanMinWidth = 12;
+
+// floor(a / b) for b > 0 (C++ division truncates toward zero).
+inline int64_t floorDiv(int64_t a, int64_t b) {
+    const int64_t q = a / b;
+    return q - ((a % b) < 0 ? 1 : 0);
+}
+
+// Top-left fill rule, for a triangle walked with positive signed area
+//   A = (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) > 0   (fixed point, y down: clockwise on screen).
+// The edge a -> b, with (dx, dy) = b - a, has the edge function
+//   E(p) = dx (p.y - a.y) - dy (p.x - a.x),
+// positive on the triangle's side (E_01(v2) = A > 0); its inward normal is (-dy, dx). A center with
+// E > 0 on all three edges is inside. A center with E == 0 lies exactly on the edge's line and
+// belongs to the triangle only if the edge is
+//   a left edge:  the interior lies at larger x   <=> -dy > 0 <=> dy < 0, or
+//   a top edge:   horizontal, interior below it (larger y on screen) <=> dy == 0 and dx > 0.
+// A neighbour sharing the edge has it with the opposite direction (-dx, -dy) once it is walked with
+// the same winding (both are oriented by the swap above), and exactly one of (dx, dy), (-dx, -dy)
+// satisfies "dy < 0 or (dy == 0 and dx > 0)" when the edge is not a point. So a center on a shared
+// edge goes to exactly one of the two triangles (no double coverage, no crack), for either input
+// winding. The rule becomes an integer bias: inside <=> E + bias >= 0 with bias = 0 for top-left
+// edges (E >= 0) and -1 otherwise (E > 0 <=> E - 1 >= 0 for integers).
+inline bool isTopLeft(int64_t dx, int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
+
+struct EdgeSetup {
+    int64_t value;  // E + bias at the first center of the box
+    int64_t stepX;  // change of E from one pixel center to the next one to the right
+    int64_t stepY;  // change of E from one row of centers to the next one down
+};
+
+inline EdgeSetup setupEdge(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64_t sx, int64_t sy) {
+    const int64_t dx = bx - ax, dy = by - ay;
+    EdgeSetup e;
+    e.value = dx * (sy - ay) - dy * (sx - ax) + (isTopLeft(dx, dy) ? 0 : -1);
+    e.stepX = -dy * kSubpixelOne;
+    e.stepY = dx * kSubpixelOne;
+    return e;
+}
+
+// The per-format, per-projection loop over all triangles (see the file comment for the steps).
+template <DepthFormat F, bool kPerspective>
+void rasterizeTriangles(const ScreenTriangles &tris, const DepthEncoder &enc, ZBuffer &zb, ZBufferStats &st) {
+    const int64_t W = zb.width, H = zb.height;
+    uint32_t *const keyBuf = zb.key.data();
+    uint32_t *const idBuf = zb.id.data();
+    double *const depthBuf = zb.depth.data();
+    uint16_t *const fragBuf = zb.fragments.data();
+    uint16_t *const passBuf = zb.passes.data();
+    const int32_t *const xy = tris.xy.data();
+    const uint32_t *const planeIndex = tris.plane.data();
+    const DepthPlane *const planes = tris.planes.data();
+
+    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawn = 0, empty = 0;
+    const size_t n = tris.size();
+    for (size_t t = 0; t < n; ++t) {
+        const int32_t *v = xy + 6 * t;
+        int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
+
+        // Bounding box of the pixel centers it may cover: x*one + half >= minX
+        // <=> x >= ceil((minX - half) / one) = (minX - half + one - 1) >> bits (arithmetic shift
+        // floors, also for negatives), and x*one + half <= maxX <=> x <= (maxX - half) >> bits.
+        const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
+        const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
+        const int64_t bx0 = std::max<int64_t>((minX - kHalf + kSubpixelOne - 1) >> kSubpixelBits, 0);
+        const int64_t bx1 = std::min<int64_t>((maxX - kHalf) >> kSubpixelBits, W - 1);
+        const int64_t by0 = std::max<int64_t>((minY - kHalf + kSubpixelOne - 1) >> kSubpixelBits, 0);
+        const int64_t by1 = std::min<int64_t>((maxY - kHalf) >> kSubpixelBits, H - 1);
+        if (bx0 > bx1 || by0 > by1) {  // no center inside the box (or box outside the viewport)
+            ++empty;
+            continue;
+        }
+        if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed) {
+            ++empty;  // outside the representable range (kMaxFixed): a clip-stage contract violation
+            continue;
+        }
+
+        // Orientation: twice the signed area; zero area draws nothing, negative is swapped so that
+        // one inside test serves both windings.
+        const int64_t area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
+        if (area == 0) {
+            ++empty;
+            continue;
+        }
+        if (area < 0) {
+            std::swap(x1, x2);
+            std::swap(y1, y2);
+        }
+        const DepthPlane plane = planes[planeIndex[t]];
+        if (!plane.valid) {
+            ++empty;
+            continue;
+        }
+        const uint32_t idValue = tris.source[t] + 1;
+
+        // Edge functions at the box's first center; edge k is the one opposite vertex k.
+        const int64_t sx = bx0 * kSubpixelOne + kHalf, sy = by0 * kSubpixelOne + kHalf;
+        const EdgeSetup e0 = setupEdge(x1, y1, x2, y2, sx, sy);
+        const EdgeSetup e1 = setupEdge(x2, y2, x0, y0, sx, sy);
+        const EdgeSetup e2 = setupEdge(x0, y0, x1, y1, sx, sy);
+
+        // One covered center: depth from the plane exactly as evalDepthPlane writes it
+        // ((a*px + b*py) + c, b*py shared by the row: the same IEEE product), then encode and test.
+        uint64_t triFragments = 0;
+        const double pa = plane.a, pb = plane.b, pc = plane.c;
+        auto shade = [&](size_t idx, double px, double bpy) {
+            const double pv = (pa * px + bpy) + pc;
+            const double d = kPerspective ? 1.0 / pv : pv;
+            uint32_t key;
+            bool oor = false;
+            encodeDepth<F>(enc, d, key, oor);
+            outOfRange += oor ? 1 : 0;
+            ++triFragments;
+            fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
+            if (key < keyBuf[idx]) {  // LESS: on equal keys the first drawn fragment stays
+                keyBuf[idx] = key;
+                idBuf[idx] = idValue;
+                depthBuf[idx] = d;
+                passBuf[idx] += passBuf[idx] != 0xFFFF ? 1 : 0;
+                ++passes;
+            }
+        };
+
+        int64_t r0 = e0.value, r1 = e1.value, r2 = e2.value;
+        if (bx1 - bx0 + 1 < kSpanMinWidth) {
+            // Narrow box: test every center, stepping the edge functions exactly.
+            for (int64_t y = by0; y <= by1; ++y) {
+                const double bpy = pb * (double(y) + 0.5);
+                const size_t row = size_t(y) * size_t(W);
+                int64_t c0 = r0, c1 = r1, c2 = r2;
+                for (int64_t x = bx0; x <= bx1; ++x) {
+                    if ((c0 | c1 | c2) >= 0) shade(row + size_t(x), double(x) + 0.5, bpy);
+                    c0 += e0.stepX;
+                    c1 += e1.stepX;
+                    c2 += e2.stepX;
+                }
+                r0 += e0.stepY;
+                r1 += e1.stepY;
+                r2 += e2.stepY;
+            }
+        } else {
+            // Wide box: per row, edge k covers offset j (x = bx0 + j) iff r_k + j * stepX_k >= 0:
+            //   stepX > 0: j >= ceil(-r / stepX) = -floor(r / stepX)
+            //   stepX < 0: j <= floor(r / -stepX)
+            //   stepX = 0: every j if r >= 0, none otherwise.
+            const int64_t lastJ = bx1 - bx0;
+            const EdgeSetup *edges[3] = {&e0, &e1, &e2};
+            for (int64_t y = by0; y <= by1; ++y) {
+                const int64_t r[3] = {r0, r1, r2};
+                int64_t lo = 0, hi = lastJ;
+                for (int k = 0; k < 3; ++k) {
+                    const int64_t s = edges[k]->stepX;
+                    if (s > 0) lo = std::max(lo, -floorDiv(r[k], s));
+                    else if (s < 0) hi = std::min(hi, floorDiv(r[k], -s));
+                    else if (r[k] < 0) hi = -1;
+                }
+                if (lo <= hi) {
+                    const double bpy = pb * (double(y) + 0.5);
+                    const size_t row = size_t(y) * size_t(W);
+                    for (int64_t x = bx0 + lo; x <= bx0 + hi; ++x) shade(row + size_t(x), double(x) + 0.5, bpy);
+                }
+                r0 += e0.stepY;
+                r1 += e1.stepY;
+                r2 += e2.stepY;
+            }
+        }
+        fragments += triFragments;
+        if (triFragments) ++drawn;
+        else ++empty;
+    }
+    st.fragments += fragments;
+    st.depthPasses += passes;
+    st.outOfRangeFragments += outOfRange;
+    st.trianglesDrawn += drawn;
+    st.trianglesEmpty += empty;
+}
+
+}  // namespace
+
+ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings) {
+    ZBufferResult r;
+    ZBuffer &zb = r.buffer;
+    zb.width = std::max(width, 0);
+    zb.height = std::max(height, 0);
+    const size_t pixels = size_t(zb.width) * size_t(zb.height);
+    zb.key.assign(pixels, std::numeric_limits<uint32_t>::max());
+    zb.id.assign(pixels, 0);
+    zb.depth.assign(pixels, std::numeric_limits<double>::infinity());
+    zb.fragments.assign(pixels, 0);
+    zb.passes.assign(pixels, 0);
+
+    ZBufferStats &st = r.stats;
+    st.trianglesIn = tris.size();
+    if (pixels > 0) {
+        const DepthEncoder &enc = settings.encoder;
+        dispatchDepthFormat(enc.format, [&]<DepthFormat F>() {
+            if (settings.orthographic) rasterizeTriangles<F, false>(tris, enc, zb, st);
+            else rasterizeTriangles<F, true>(tris, enc, zb, st);
+        });
+    } else {
+        st.trianglesEmpty = tris.size();
+    }
+    finishZBufferStats(zb, &st);
+    return r;
+}
+
+void finishZBufferStats(const ZBuffer &zb, ZBufferStats *stats) {
+    // Histogram over the (saturating) per-pixel fragment counts; [0] counts uncovered pixels.
+    std::vector<uint64_t> hist(1, 0);
+    uint32_t maxCount = 0;
+    for (uint16_t c : zb.fragments) {
+        if (c >= hist.size()) hist.resize(size_t(c) + 1, 0);
+        ++hist[c];
+        maxCount = std::max<uint32_t>(maxCount, c);
+    }
+    const uint64_t pixels = zb.fragments.size();
+    stats->coveredPixels = pixels - hist[0];
+    stats->maxDepthComplexity = maxCount;
+    stats->histogram = std::move(hist);
+    if (stats->coveredPixels > 0) {
+        stats->overdraw = double(stats->depthPasses) / double(stats->coveredPixels);
+        stats->depthComplexity = double(stats->fragments) / double(stats->coveredPixels);
+    } else {
+        stats->overdraw = 0;
+        stats->depthComplexity = 0;
+    }
+}
+
+}  // namespace va
