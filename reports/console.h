@@ -11,9 +11,9 @@ namespace va {
 //
 //   view 'spawn' 1920x1080 f32 perspective
 //     stage      status      tris in      culled         out        ms
-//     frustum    ran              1200         400         800       0.3
-//     occlusion  skipped   scene has no occluders
-//     zbuffer    ran               800           0         800       2.5
+//     cells      skipped scene has no cells
+//     frustum    ran            1200         400         800       0.3
+//     zbuffer    ran             800           0         800       2.5
 //     zbuffer: 12345 covered pixels, overdraw 1.23, depth complexity 1.50 (max 4)
 //
 // Counts are right-aligned in 11 columns (wider numbers push the row, never truncate), ms have one

@@ -64,7 +64,7 @@ bool writeImageAtomic(const std::string &path, const char *format, const ImageSp
 // The legend is a row of swatches with their values below, right-aligned in a strip that extends
 // the canvas below the image. All sizes are multiples of the font scale s:
 //   strip height = margin 3s + swatch 6s + gap 2s + text 7s + margin 3s = 21s
-//   cell width   = max(widest label, 7s) + 2s (the last 2s is the gap to the next swatch)
+//   cell width   = max(widest label, 7s) + gap 4s (the gap keeps "10" "11" apart from "1011")
 constexpr Rgb8 kStripBackground{24, 24, 24};
 constexpr Rgb8 kLegendText{255, 255, 255};
 constexpr Rgb8 kSwatchOutline{160, 160, 160};
@@ -83,7 +83,7 @@ std::vector<uint32_t> legendValues(uint32_t cap) {
 }
 
 struct LegendLayout {
-    int scale = 1, margin = 0, swatchH = 0, cellW = 0, stripH = 0, width = 0;
+    int scale = 1, margin = 0, swatchH = 0, gap = 0, cellW = 0, stripH = 0, width = 0;
 };
 LegendLayout legendLayout(const std::vector<uint32_t> &values, int imageWidth) {
     LegendLayout L;
@@ -93,9 +93,10 @@ LegendLayout legendLayout(const std::vector<uint32_t> &values, int imageWidth) {
     for (uint32_t v : values) labelW = std::max(labelW, textWidth(std::to_string(v), s));
     L.margin = 3 * s;
     L.swatchH = 6 * s;
-    L.cellW = std::max(labelW, 7 * s) + 2 * s;
+    L.gap = 4 * s;
+    L.cellW = std::max(labelW, 7 * s) + L.gap;
     L.stripH = L.margin + L.swatchH + 2 * s + textHeight(s) + L.margin;
-    L.width = int(values.size()) * L.cellW - 2 * s;
+    L.width = int(values.size()) * L.cellW - L.gap;
     return L;
 }
 
@@ -210,13 +211,13 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
                 const Rgb8 c = overdrawColor(zb.fragments[size_t(y) * size_t(W) + size_t(x)], cap);
                 fillRect(rgb, CW, x, y, x + 1, y + 1, c);
             }
-        // Legend, right-aligned: swatch i spans [x_i, x_i + cellW - 2s) x [top, top + swatchH), with a
+        // Legend, right-aligned: swatch i spans [x_i, x_i + cellW - gap) x [top, top + swatchH), with a
         // one-cell outline so that the black "0" swatch shows on the dark strip; its label is centered
         // below it.
         const int s = L.scale;
         const int x0 = CW - L.margin - L.width, top = H + L.margin;
         for (size_t i = 0; i < values.size(); ++i) {
-            const int xi = x0 + int(i) * L.cellW, sw = L.cellW - 2 * s;
+            const int xi = x0 + int(i) * L.cellW, sw = L.cellW - L.gap;
             fillRect(rgb, CW, xi, top, xi + sw, top + L.swatchH, kSwatchOutline);
             fillRect(rgb, CW, xi + s, top + s, xi + sw - s, top + L.swatchH - s, overdrawColor(values[i], cap));
             const std::string label = std::to_string(values[i]);

@@ -554,11 +554,11 @@ TEST(ReportImages, WriteAndReadBack) {
     for (size_t i = 0; i < 12; ++i) EXPECT_EQ(g.u8[i], depthGray(v.buffer.depth[i], 0.1, 1000)) << i;
 
     // overdraw.png: cap = max(8, 9) = 9, legend values 0..9 (10 swatches). Layout at scale 1:
-    //   cell width = max(label width 5, 7) + 2 = 9; legend width = 10 * 9 - 2 = 88;
-    //   canvas width = max(4, 88 + 2 * 3) = 94; strip height = 3 + 6 + 2 + 7 + 3 = 21 -> 3 + 21 = 24.
+    //   cell width = max(label width 5, 7) + gap 4 = 11; legend width = 10 * 11 - 4 = 106;
+    //   canvas width = max(4, 106 + 2 * 3) = 112; strip height = 3 + 6 + 2 + 7 + 3 = 21 -> 3 + 21 = 24.
     ImageData o;
     ASSERT_TRUE(readImage(dir.path + "/img_test.overdraw.png", &o, &err)) << err;
-    EXPECT_EQ(o.width, 94);
+    EXPECT_EQ(o.width, 112);
     EXPECT_EQ(o.height, 24);
     ASSERT_EQ(o.channels(), 3);
     EXPECT_EQ(rgbAt(o, 0, 0), (Px{32, 64, 255}));     // 1 fragment: blue
@@ -568,11 +568,11 @@ TEST(ReportImages, WriteAndReadBack) {
     EXPECT_EQ(rgbAt(o, 0, 1), (Px{16, 132, 255}));    // 2
     EXPECT_EQ(rgbAt(o, 4, 0), (Px{24, 24, 24}));      // canvas widened right of the image: strip color
     EXPECT_EQ(rgbAt(o, 0, 3), (Px{24, 24, 24}));      // strip below the image
-    // Legend: x0 = 94 - 3 - 88 = 3, swatches at y 6..11 (outline) with interior y 7..10.
+    // Legend: x0 = 112 - 3 - 106 = 3, swatches at y 6..11 (outline) with interior y 7..10.
     EXPECT_EQ(rgbAt(o, 3, 6), (Px{160, 160, 160}));   // swatch "0" outline
     EXPECT_EQ(rgbAt(o, 5, 8), (Px{0, 0, 0}));         // swatch "0" interior
-    EXPECT_EQ(rgbAt(o, 3 + 9 + 3, 8), (Px{32, 64, 255}));       // swatch "1"
-    EXPECT_EQ(rgbAt(o, 3 + 9 * 9 + 3, 8), (Px{255, 255, 255})); // swatch "9"
+    EXPECT_EQ(rgbAt(o, 3 + 11 + 3, 8), (Px{32, 64, 255}));       // swatch "1"
+    EXPECT_EQ(rgbAt(o, 3 + 9 * 11 + 3, 8), (Px{255, 255, 255})); // swatch "9"
     // Label "0" at x = 3 + (7 - 5) / 2 = 4, y = 6 + 6 + 2 = 14: glyph row 0 is .###. -> x 5..7.
     EXPECT_EQ(rgbAt(o, 4, 14), (Px{24, 24, 24}));
     EXPECT_EQ(rgbAt(o, 5, 14), (Px{255, 255, 255}));
