@@ -28,6 +28,9 @@ std::string sanitizeFileName(const std::string &viewName);
 // (compared case-insensitively, so they stay distinct on macOS/Windows file systems) resolved in
 // view order by appending "-2", "-3", ...: the first view keeps the plain name. Deterministic.
 std::vector<std::string> imageBaseNames(const std::vector<ViewResult> &views);
+// The same names from the view specs, before the analysis (views[i] gets element i): a caller
+// that writes each view's images as soon as it is analysed passes element i to writeViewImages.
+std::vector<std::string> imageBaseNames(const std::vector<ViewSpec> &views);
 
 // The image files of one view, named from its base name (the keys are report.json's "images").
 struct ViewImageNames {

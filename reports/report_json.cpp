@@ -32,7 +32,8 @@ std::string sanitizeFileName(const std::string &viewName) {
     return s;
 }
 
-std::vector<std::string> imageBaseNames(const std::vector<ViewResult> &views) {
+namespace {
+std::vector<std::string> uniqueBaseNames(const std::vector<const std::string *> &names) {
     // Names are compared in lower case: "Hall" and "hall" would be one file on a case-insensitive
     // file system (macOS, Windows), so they count as a collision.
     auto lower = [](std::string s) {
@@ -41,15 +42,28 @@ std::vector<std::string> imageBaseNames(const std::vector<ViewResult> &views) {
     };
     std::set<std::string> taken;
     std::vector<std::string> out;
-    out.reserve(views.size());
-    for (const ViewResult &v : views) {
-        const std::string base = sanitizeFileName(v.spec.name);
+    out.reserve(names.size());
+    for (const std::string *viewName : names) {
+        const std::string base = sanitizeFileName(*viewName);
         std::string name = base;
         for (int k = 2; taken.count(lower(name)); ++k) name = base + "-" + std::to_string(k);
         taken.insert(lower(name));
         out.push_back(name);
     }
     return out;
+}
+}  // namespace
+
+std::vector<std::string> imageBaseNames(const std::vector<ViewResult> &views) {
+    std::vector<const std::string *> names;
+    for (const ViewResult &v : views) names.push_back(&v.spec.name);
+    return uniqueBaseNames(names);
+}
+
+std::vector<std::string> imageBaseNames(const std::vector<ViewSpec> &views) {
+    std::vector<const std::string *> names;
+    for (const ViewSpec &v : views) names.push_back(&v.name);
+    return uniqueBaseNames(names);
 }
 
 ViewImageNames viewImageNames(const std::string &baseName) {

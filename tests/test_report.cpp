@@ -446,6 +446,9 @@ TEST(ReportNames, CollisionsResolvedInViewOrder) {
     for (int i = 0; i < 6; ++i) views[size_t(i)].spec.name = names[i];
     const std::vector<std::string> expected = {"a_b", "a_b-2", "A_B-3", "a_b-2-2", "x", "a_b-4"};
     EXPECT_EQ(imageBaseNames(views), expected);
+    std::vector<ViewSpec> specs;
+    for (const auto &v : views) specs.push_back(v.spec);
+    EXPECT_EQ(imageBaseNames(specs), expected);
 }
 
 // ---- Images ------------------------------------------------------------------------------------
