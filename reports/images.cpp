@@ -47,9 +47,14 @@ bool writeImageAtomic(const std::string &path, const char *format, const ImageSp
         if (err) *err = "cannot write image '" + path + "': " + msg;
         return false;
     };
+    // OpenImageIO stamps OpenEXR files with the current time (capDate) unless DateTime is set; an
+    // empty DateTime keeps the files byte-identical across runs (DESIGN.md: images are identical
+    // across runs, so CI can diff them).
+    ImageSpec stamped = spec;
+    if (!stamped.find_attribute("DateTime")) stamped.attribute("DateTime", "");
     auto out = ImageOutput::create(format);
     if (!out) return fail("no OpenImageIO writer for " + std::string(format) + ": " + OIIO::geterror());
-    if (!out->open(tmp, spec)) return fail(out->geterror());
+    if (!out->open(tmp, stamped)) return fail(out->geterror());
     if (!out->write_image(spec.format, pixels)) {
         const std::string msg = out->geterror();
         out->close();

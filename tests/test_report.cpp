@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <ctime>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -581,6 +583,27 @@ TEST(ReportImages, WriteAndReadBack) {
     EXPECT_EQ(rgbAt(o, 5, 14), (Px{255, 255, 255}));
     EXPECT_EQ(rgbAt(o, 7, 14), (Px{255, 255, 255}));
     EXPECT_EQ(rgbAt(o, 8, 14), (Px{24, 24, 24}));
+}
+
+std::string fileBytes(const std::string &p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+// Images are byte-identical across runs: no timestamps (OpenEXR's capDate has one-second
+// resolution, so the second write waits for the clock's second to change).
+TEST(ReportImages, ByteIdenticalAcrossRuns) {
+    TempDir a, b;
+    std::string err;
+    ASSERT_TRUE(writeViewImages(imageView(), a.path, "v", &err)) << err;
+    const std::time_t t0 = std::time(nullptr);
+    while (std::time(nullptr) == t0) ::usleep(20000);
+    ASSERT_TRUE(writeViewImages(imageView(), b.path, "v", &err)) << err;
+    for (const char *f : {"v.depth.exr", "v.depth.png", "v.overdraw.png", "v.ids.exr"}) {
+        const std::string x = fileBytes(a.path + "/" + f), y = fileBytes(b.path + "/" + f);
+        EXPECT_FALSE(x.empty()) << f;
+        EXPECT_TRUE(x == y) << f << " differs between two writes";
+    }
 }
 
 TEST(ReportImages, LargeImageKeepsWidthAndScalesLegend) {
