@@ -15,9 +15,14 @@
 #include "render/raster.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "render/depth_format_impl.h"
 
@@ -45,6 +50,48 @@ constexpr int64_t kMaxFixed = int64_t(1) << 29;
 // Pixel x's sample (center) in fixed point is x * kSubpixelOne + kHalf.
 constexpr int64_t kHalf = kSubpixelOne / 2;
 
+// Tiny triangles: a box of at most 4 x 4 centers is tested as one block of 4 x 4 samples in
+// 32-bit lanes, when the vertex extent is at most kTinyExtent in both axes. 32 bits suffice then:
+// every sample of the block lies within the vertex box grown by 3 pixels (the box of centers lies
+// inside the vertex box), so |E| = |dx (sy - ay) - dy (sx - ax)| <= 2 ext (ext + 3 px) with
+// ext <= 64 px = 2^14: 2 * 2^14 * (2^14 + 768) < 2^30, and the bias and steps stay below that too.
+constexpr int64_t kTinyExtent = int64_t(64) << kSubpixelBits;
+
+// 4 x 4 coverage bits (bit 4 row + column) of the block whose first center has edge values
+// r[k] (bias included); stepX/stepY as in EdgeSetup, all fitting in int32 (see kTinyExtent).
+inline uint32_t tinyCoverage(const int32_t r[3], const int32_t stepX[3], const int32_t stepY[3]) {
+#if defined(__SSE2__)
+    // Lanes are the four columns; a center is outside when any edge value is negative, i.e. when
+    // the sign bit of e0 | e1 | e2 is set (movemask collects the four sign bits).
+    __m128i e[3], dy[3];
+    for (int k = 0; k < 3; ++k) {
+        // r, r + s, r + 2s, r + 3s (lane 0 = column 0)
+        e[k] = _mm_set_epi32(r[k] + 3 * stepX[k], r[k] + 2 * stepX[k], r[k] + stepX[k], r[k]);
+        dy[k] = _mm_set1_epi32(stepY[k]);
+    }
+    uint32_t outside = 0;
+    for (int row = 0; row < 4; ++row) {
+        const __m128i any = _mm_or_si128(_mm_or_si128(e[0], e[1]), e[2]);
+        outside |= uint32_t(_mm_movemask_ps(_mm_castsi128_ps(any))) << (4 * row);
+        for (int k = 0; k < 3; ++k) e[k] = _mm_add_epi32(e[k], dy[k]);
+    }
+    return ~outside & 0xFFFFu;
+#else
+    uint32_t inside = 0;
+    for (int row = 0; row < 4; ++row)
+        for (int col = 0; col < 4; ++col) {
+            const int32_t e0 = r[0] + row * stepY[0] + col * stepX[0];
+            const int32_t e1 = r[1] + row * stepY[1] + col * stepX[1];
+            const int32_t e2 = r[2] + row * stepY[2] + col * stepX[2];
+            inside |= uint32_t((e0 | e1 | e2) >= 0) << (4 * row + col);
+        }
+    return inside;
+#endif
+}
+
+// Boxes of at most kMaskSide x kMaskSide centers are tested into a 64-bit mask first.
+constexpr int64_t kMaskSide = 8;
+
 // Boxes at least this many pixels wide use the per-row span solver instead of scanning centers.
 constexpr int64_t kSpanMinWidth = 12;
 
@@ -69,7 +116,8 @@ inline int64_t floorDiv(int64_t a, int64_t b) {
 // edge goes to exactly one of the two triangles (no double coverage, no crack), for either input
 // winding. The rule becomes an integer bias: inside <=> E + bias >= 0 with bias = 0 for top-left
 // edges (E >= 0) and -1 otherwise (E > 0 <=> E - 1 >= 0 for integers).
-inline bool isTopLeft(int64_t dx, int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
+// (Bitwise on purpose: no short-circuit branch, the edge directions are data.)
+inline bool isTopLeft(int64_t dx, int64_t dy) { return (dy < 0) | ((dy == 0) & (dx > 0)); }
 
 struct EdgeSetup {
     int64_t value;  // E + bias at the first center of the box
@@ -160,17 +208,57 @@ void rasterizeTriangles(const ScreenTriangles &tris, const DepthEncoder &enc, ZB
             outOfRange += oor ? 1 : 0;
             ++triFragments;
             fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
-            if (key < keyBuf[idx]) {  // LESS: on equal keys the first drawn fragment stays
-                keyBuf[idx] = key;
-                idBuf[idx] = idValue;
-                depthBuf[idx] = d;
-                passBuf[idx] += passBuf[idx] != 0xFFFF ? 1 : 0;
-                ++passes;
-            }
+            // LESS: on equal keys the first drawn fragment stays. Written as selects, not a branch:
+            // about half the fragments pass, in no predictable pattern.
+            const uint32_t oldKey = keyBuf[idx];
+            const bool pass = key < oldKey;
+            keyBuf[idx] = pass ? key : oldKey;
+            idBuf[idx] = pass ? idValue : idBuf[idx];
+            depthBuf[idx] = pass ? d : depthBuf[idx];
+            passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
+            passes += pass ? 1 : 0;
         };
 
         int64_t r0 = e0.value, r1 = e1.value, r2 = e2.value;
-        if (bx1 - bx0 + 1 < kSpanMinWidth) {
+        const int64_t boxW = bx1 - bx0 + 1, boxH = by1 - by0 + 1;
+        if ((boxW | boxH) <= 4 && maxX - minX <= kTinyExtent && maxY - minY <= kTinyExtent) {
+            // Tiny: one 4 x 4 block, no data-dependent branch until the covered bits are shaded.
+            const int32_t r[3] = {int32_t(r0), int32_t(r1), int32_t(r2)};
+            const int32_t stepX[3] = {int32_t(e0.stepX), int32_t(e1.stepX), int32_t(e2.stepX)};
+            const int32_t stepY[3] = {int32_t(e0.stepY), int32_t(e1.stepY), int32_t(e2.stepY)};
+            // Bits of the block that lie inside the box: boxW columns of each of boxH rows.
+            const uint32_t boxBits = ((1u << boxW) - 1) * (0x1111u & ((1u << (4 * boxH)) - 1));
+            uint32_t mask = tinyCoverage(r, stepX, stepY) & boxBits;
+            while (mask) {
+                const int bit = std::countr_zero(mask);
+                mask &= mask - 1;
+                const int64_t x = bx0 + (bit & 3), y = by0 + (bit >> 2);
+                shade(size_t(y) * size_t(W) + size_t(x), double(x) + 0.5, pb * (double(y) + 0.5));
+            }
+        } else if (boxW <= kMaskSide && boxH <= kMaskSide) {
+            // Small box (most triangles of a dense mesh): the inside test of every center goes
+            // into a bit mask (bit 8 row + column) without a data-dependent branch, then the set
+            // bits are shaded. The loops' trip counts are the box size, the only branches left.
+            uint64_t mask = 0;
+            for (int64_t y = 0; y < boxH; ++y) {
+                int64_t c0 = r0, c1 = r1, c2 = r2;
+                for (int64_t x = 0; x < boxW; ++x) {
+                    mask |= uint64_t((c0 | c1 | c2) >= 0) << (y * kMaskSide + x);
+                    c0 += e0.stepX;
+                    c1 += e1.stepX;
+                    c2 += e2.stepX;
+                }
+                r0 += e0.stepY;
+                r1 += e1.stepY;
+                r2 += e2.stepY;
+            }
+            while (mask) {
+                const int bit = std::countr_zero(mask);
+                mask &= mask - 1;
+                const int64_t x = bx0 + (bit & (kMaskSide - 1)), y = by0 + (bit / kMaskSide);
+                shade(size_t(y) * size_t(W) + size_t(x), double(x) + 0.5, pb * (double(y) + 0.5));
+            }
+        } else if (boxW < kSpanMinWidth) {
             // Narrow box: test every center, stepping the edge functions exactly.
             for (int64_t y = by0; y <= by1; ++y) {
                 const double bpy = pb * (double(y) + 0.5);
@@ -254,13 +342,12 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
 
 void finishZBufferStats(const ZBuffer &zb, ZBufferStats *stats) {
     // Histogram over the (saturating) per-pixel fragment counts; [0] counts uncovered pixels.
-    std::vector<uint64_t> hist(1, 0);
-    uint32_t maxCount = 0;
-    for (uint16_t c : zb.fragments) {
-        if (c >= hist.size()) hist.resize(size_t(c) + 1, 0);
-        ++hist[c];
-        maxCount = std::max<uint32_t>(maxCount, c);
-    }
+    // Counted into a table for every uint16 value, then cut after the largest count seen.
+    std::vector<uint64_t> hist(size_t(0xFFFF) + 1, 0);
+    for (uint16_t c : zb.fragments) ++hist[c];
+    uint32_t maxCount = 0xFFFF;
+    while (maxCount > 0 && hist[maxCount] == 0) --maxCount;
+    hist.resize(size_t(maxCount) + 1);
     const uint64_t pixels = zb.fragments.size();
     stats->coveredPixels = pixels - hist[0];
     stats->maxDepthComplexity = maxCount;
