@@ -50,49 +50,54 @@ constexpr int64_t kMaxFixed = int64_t(1) << 29;
 // Pixel x's sample (center) in fixed point is x * kSubpixelOne + kHalf.
 constexpr int64_t kHalf = kSubpixelOne / 2;
 
-// Tiny triangles: a box of at most 4 x 4 centers is tested as one block of 4 x 4 samples in
-// 32-bit lanes, when the vertex extent is at most kTinyExtent in both axes. 32 bits suffice then:
-// every sample of the block lies within the vertex box grown by 3 pixels (the box of centers lies
-// inside the vertex box), so |E| = |dx (sy - ay) - dy (sx - ax)| <= 2 ext (ext + 3 px) with
-// ext <= 64 px = 2^14: 2 * 2^14 * (2^14 + 768) < 2^30, and the bias and steps stay below that too.
-constexpr int64_t kTinyExtent = int64_t(64) << kSubpixelBits;
+// Small triangles: a box of at most 8 x 8 centers is tested as one block of 4 x 4 or 8 x 8 samples
+// in 32-bit lanes, when the vertex extent is at most kBlockExtent in both axes. 32 bits suffice
+// then: every sample of the block lies within the vertex box grown by 7 pixels (the box of centers
+// lies inside the vertex box), so |E| = |dx (sy - ay) - dy (sx - ax)| <= 2 ext (ext + 7 px) with
+// ext <= 64 px = 2^14: 2 * 2^14 * (2^14 + 1792) < 2^30; the bias and the steps stay below that.
+constexpr int64_t kBlockExtent = int64_t(64) << kSubpixelBits;
+constexpr uint64_t kRowStarts = 0x0101010101010101ull;  // bit 0 of each of 8 rows
 
-// 4 x 4 coverage bits (bit 4 row + column) of the block whose first center has edge values
-// r[k] (bias included); stepX/stepY as in EdgeSetup, all fitting in int32 (see kTinyExtent).
-inline uint32_t tinyCoverage(const int32_t r[3], const int32_t stepX[3], const int32_t stepY[3]) {
+// Coverage bits (bit 8 row + column) of the kRows x kCols block whose first center has the edge
+// values r[k] (bias included), stepX/stepY as in EdgeSetup, all in int32 (see kBlockExtent).
+// No data-dependent branch: the loops have constant trip counts and unroll.
+template <int kRows, int kCols>
+inline uint64_t blockCoverage(const int32_t r[3], const int32_t stepX[3], const int32_t stepY[3]) {
 #if defined(__SSE2__)
-    // Lanes are the four columns; a center is outside when any edge value is negative, i.e. when
-    // the sign bit of e0 | e1 | e2 is set (movemask collects the four sign bits).
-    __m128i e[3], dy[3];
+    // Lanes are columns; a center is outside when any edge value is negative, i.e. when the sign
+    // bit of e0 | e1 | e2 is set (movemask gathers four sign bits).
+    constexpr int kVecs = kCols / 4;
+    __m128i e[kVecs][3], dy[3];
     for (int k = 0; k < 3; ++k) {
-        // r, r + s, r + 2s, r + 3s (lane 0 = column 0)
-        e[k] = _mm_set_epi32(r[k] + 3 * stepX[k], r[k] + 2 * stepX[k], r[k] + stepX[k], r[k]);
+        for (int v = 0; v < kVecs; ++v) {
+            const int32_t c = r[k] + 4 * v * stepX[k];  // column 4v
+            e[v][k] = _mm_set_epi32(c + 3 * stepX[k], c + 2 * stepX[k], c + stepX[k], c);
+        }
         dy[k] = _mm_set1_epi32(stepY[k]);
     }
-    uint32_t outside = 0;
-    for (int row = 0; row < 4; ++row) {
-        const __m128i any = _mm_or_si128(_mm_or_si128(e[0], e[1]), e[2]);
-        outside |= uint32_t(_mm_movemask_ps(_mm_castsi128_ps(any))) << (4 * row);
-        for (int k = 0; k < 3; ++k) e[k] = _mm_add_epi32(e[k], dy[k]);
-    }
-    return ~outside & 0xFFFFu;
+    uint64_t outside = 0;
+    for (int row = 0; row < kRows; ++row)
+        for (int v = 0; v < kVecs; ++v) {
+            const __m128i any = _mm_or_si128(_mm_or_si128(e[v][0], e[v][1]), e[v][2]);
+            outside |= uint64_t(_mm_movemask_ps(_mm_castsi128_ps(any))) << (8 * row + 4 * v);
+            for (int k = 0; k < 3; ++k) e[v][k] = _mm_add_epi32(e[v][k], dy[k]);
+        }
+    return ~outside;
 #else
-    uint32_t inside = 0;
-    for (int row = 0; row < 4; ++row)
-        for (int col = 0; col < 4; ++col) {
+    uint64_t inside = 0;
+    for (int row = 0; row < kRows; ++row)
+        for (int col = 0; col < kCols; ++col) {
             const int32_t e0 = r[0] + row * stepY[0] + col * stepX[0];
             const int32_t e1 = r[1] + row * stepY[1] + col * stepX[1];
             const int32_t e2 = r[2] + row * stepY[2] + col * stepX[2];
-            inside |= uint32_t((e0 | e1 | e2) >= 0) << (4 * row + col);
+            inside |= uint64_t((e0 | e1 | e2) >= 0) << (8 * row + col);
         }
     return inside;
 #endif
 }
 
-// Boxes of at most kMaskSide x kMaskSide centers are tested into a 64-bit mask first.
-constexpr int64_t kMaskSide = 8;
-
-// Boxes at least this many pixels wide use the per-row span solver instead of scanning centers.
+// Boxes at least this many pixels wide use the per-row span solver instead of scanning centers
+// (narrower ones that are not small blocks scan every center of the box).
 constexpr int64_t kSpanMinWidth = 12;
 
 // floor(a / b) for b > 0 (C++ division truncates toward zero).
@@ -221,41 +226,21 @@ void rasterizeTriangles(const ScreenTriangles &tris, const DepthEncoder &enc, ZB
 
         int64_t r0 = e0.value, r1 = e1.value, r2 = e2.value;
         const int64_t boxW = bx1 - bx0 + 1, boxH = by1 - by0 + 1;
-        if ((boxW | boxH) <= 4 && maxX - minX <= kTinyExtent && maxY - minY <= kTinyExtent) {
-            // Tiny: one 4 x 4 block, no data-dependent branch until the covered bits are shaded.
+        if (((boxW - 1) | (boxH - 1)) < 8 && maxX - minX <= kBlockExtent && maxY - minY <= kBlockExtent) {
+            // Small (most triangles of a dense mesh): one 4 x 4 or 8 x 8 block of inside tests
+            // ((w-1)|(h-1) < n <=> both sides <= n for n a power of two), then shade the set bits.
             const int32_t r[3] = {int32_t(r0), int32_t(r1), int32_t(r2)};
             const int32_t stepX[3] = {int32_t(e0.stepX), int32_t(e1.stepX), int32_t(e2.stepX)};
             const int32_t stepY[3] = {int32_t(e0.stepY), int32_t(e1.stepY), int32_t(e2.stepY)};
-            // Bits of the block that lie inside the box: boxW columns of each of boxH rows.
-            const uint32_t boxBits = ((1u << boxW) - 1) * (0x1111u & ((1u << (4 * boxH)) - 1));
-            uint32_t mask = tinyCoverage(r, stepX, stepY) & boxBits;
+            const uint64_t cover = ((boxW - 1) | (boxH - 1)) < 4 ? blockCoverage<4, 4>(r, stepX, stepY)
+                                                               : blockCoverage<8, 8>(r, stepX, stepY);
+            // Bits of the block inside the box: boxW columns of each of the first boxH rows.
+            const uint64_t boxBits = ((uint64_t(1) << boxW) - 1) * (kRowStarts >> (64 - 8 * boxH));
+            uint64_t mask = cover & boxBits;
             while (mask) {
                 const int bit = std::countr_zero(mask);
                 mask &= mask - 1;
-                const int64_t x = bx0 + (bit & 3), y = by0 + (bit >> 2);
-                shade(size_t(y) * size_t(W) + size_t(x), double(x) + 0.5, pb * (double(y) + 0.5));
-            }
-        } else if (boxW <= kMaskSide && boxH <= kMaskSide) {
-            // Small box (most triangles of a dense mesh): the inside test of every center goes
-            // into a bit mask (bit 8 row + column) without a data-dependent branch, then the set
-            // bits are shaded. The loops' trip counts are the box size, the only branches left.
-            uint64_t mask = 0;
-            for (int64_t y = 0; y < boxH; ++y) {
-                int64_t c0 = r0, c1 = r1, c2 = r2;
-                for (int64_t x = 0; x < boxW; ++x) {
-                    mask |= uint64_t((c0 | c1 | c2) >= 0) << (y * kMaskSide + x);
-                    c0 += e0.stepX;
-                    c1 += e1.stepX;
-                    c2 += e2.stepX;
-                }
-                r0 += e0.stepY;
-                r1 += e1.stepY;
-                r2 += e2.stepY;
-            }
-            while (mask) {
-                const int bit = std::countr_zero(mask);
-                mask &= mask - 1;
-                const int64_t x = bx0 + (bit & (kMaskSide - 1)), y = by0 + (bit / kMaskSide);
+                const int64_t x = bx0 + (bit & 7), y = by0 + (bit >> 3);
                 shade(size_t(y) * size_t(W) + size_t(x), double(x) + 0.5, pb * (double(y) + 0.5));
             }
         } else if (boxW < kSpanMinWidth) {
