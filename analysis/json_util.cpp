@@ -55,6 +55,23 @@ bool parseFile(const std::string &file, Doc *doc, std::string *err) {
         if (k != std::string::npos) what = what.substr(k + 2);
         *err = file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": JSON syntax error: " + what;
         return false;
+    } catch (const Json::exception &e) {
+        // out_of_range.406: a number literal too large for a double ("number overflow parsing
+        // '1e999'"). nlohmann gives no offset: place it at the literal's first occurrence.
+        std::string what = e.what();
+        const size_t k = what.find("] ");
+        if (k != std::string::npos) what = what.substr(k + 2);
+        size_t at = std::string::npos;
+        const size_t q = what.find('\'');
+        if (q != std::string::npos) {
+            const size_t q2 = what.find('\'', q + 1);
+            if (q2 != std::string::npos) at = doc->text.find(what.substr(q + 1, q2 - q - 1));
+        }
+        size_t line = 1, col = 1;
+        if (at != std::string::npos) lineCol(doc->text, at, &line, &col);
+        *err = file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": JSON error: " + what +
+               " (the number does not fit a double)";
+        return false;
     }
     return true;
 }

@@ -452,7 +452,16 @@ bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::str
 
 bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
     const std::string ext = lowerExt(path);
-    if (ext == ".json") return loadSceneJson(path, opt, out, err);
+    if (ext == ".json") {
+        // Every expected failure returns false; this only turns a library exception we did not
+        // foresee into a message instead of letting it cross the loader.
+        try {
+            return loadSceneJson(path, opt, out, err);
+        } catch (const std::exception &e) {
+            *err = path + ": internal error while reading the scene: " + e.what();
+            return false;
+        }
+    }
     SceneBuildInput in;
     if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl") {
         SceneBuildInput::Object o;
