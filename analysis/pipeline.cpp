@@ -167,7 +167,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
 }
 
 bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const PipelineSettings &s,
-                  const std::function<bool(ViewResult &, std::string *)> &onView, AnalysisResult *out,
+                  const std::function<bool(size_t index, ViewResult &, std::string *)> &onView, AnalysisResult *out,
                   std::string *err) {
     // Validate every view before any work, so bad input never leaves a partial report.
     std::vector<ViewSpec> resolved(views.size());
@@ -193,7 +193,7 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         if (failed) return;
         ViewResult v = analyzeView(ps, resolved[i], cams[i], s);
         std::string e;
-        if (onView && !onView(v, &e)) {
+        if (onView && !onView(i, v, &e)) {
             std::lock_guard<std::mutex> lock(errMutex);
             if (!failed.exchange(true)) firstErr = e;
             return;

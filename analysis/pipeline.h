@@ -42,11 +42,12 @@ bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, C
 // Runs every stage for one (resolved) view.
 ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Camera &cam, const PipelineSettings &s);
 
-// Runs every view (in parallel); `onView` is called once per finished view, from worker threads,
+// Runs every view (in parallel); `onView` is called once per finished view (with its index in
+// `views`), from worker threads,
 // and may write images and release the view's buffers. Results keep the views' order.
 // Returns false (with *err) when a view is invalid or onView fails; nothing is half-reported.
 bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const PipelineSettings &s,
-                  const std::function<bool(ViewResult &, std::string *)> &onView, AnalysisResult *out,
+                  const std::function<bool(size_t index, ViewResult &, std::string *)> &onView, AnalysisResult *out,
                   std::string *err);
 
 }  // namespace va

@@ -145,8 +145,10 @@ int cmdAnalyze(const Options &o) {
     std::atomic<int> done{0};
     std::mutex printMutex;
     AnalysisResult result;
-    auto onView = [&](ViewResult &v, std::string *e) {
-        if (!writeViewImages(v, out.staging(), e)) return false;
+    // Image names are fixed before the parallel run, so colliding view names stay distinct.
+    const std::vector<std::string> bases = imageBaseNames(views);
+    auto onView = [&](size_t i, ViewResult &v, std::string *e) {
+        if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
         v.buffer = ZBuffer{};  // the images hold it now
         const int k = ++done;
         if (!o.quiet) {
@@ -162,11 +164,14 @@ int cmdAnalyze(const Options &o) {
     }
     if (tty && !o.quiet) std::fprintf(stderr, "\n");
     result.loadMs = loadMs;
+    // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
+    // with the path, and the previous report stays as it was.
     if (!writeFileAtomic(out.staging() + "/report.json", reportJson(result).dump(2) + "\n", &err) ||
         !out.commit(&err)) {
         fail(err);
-        return kExitInternal;
+        return kExitBadInput;
     }
+    if (!err.empty()) std::fprintf(stderr, "visaudit: warning: %s\n", err.c_str());
     if (!o.quiet) {
         for (const ViewResult &v : result.views) std::printf("%s\n", funnelTable(v).c_str());
         std::printf("report: %s/report.json\n", o.out.c_str());

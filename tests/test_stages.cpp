@@ -131,7 +131,7 @@ TEST(Clip, TriangleCrossingNearPlaneIsClippedToAQuad) {
 TEST(Clip, VertexBehindEyeNothingDrawnFromBehind) {
     // One vertex behind the eye (d = -2): the projected triangle would wrap around through infinity
     // if it were divided before clipping. Compare coverage with a ray-plane reference.
-    const Vec3 a{0, 0.5, 2}, b{-2, -1, -4}, c{2, -1, -4};
+    const Vec3 a{0, 1.5, 2}, b{-2, -1, -4}, c{2, -1, -4};  // front-facing; eye not in its plane
     const Scene scene = sceneOf({triangleMesh(a, b, c)});
     const ViewSpec view = viewOf({0, 0, 0}, {0, 0, -1}, 64, 48, 90, 0.5, 100);
     const ViewResult r = run(scene, view);
