@@ -18,10 +18,6 @@ mkdir -p "$DATA" "$CACHE"
 fetch_deb() {
   local pkg="$1" deb
   deb="$(ls "$CACHE"/"${pkg}"_*.deb 2>/dev/null | head -n1 || true)"
-  if [[ -z "$deb" && -d /tmp/pkgs ]]; then
-    deb="$(ls /tmp/pkgs/"${pkg}"_*.deb 2>/dev/null | head -n1 || true)"
-    [[ -n "$deb" ]] && cp "$deb" "$CACHE/" && deb="$CACHE/$(basename "$deb")"
-  fi
   if [[ -z "$deb" ]]; then
     if ! (cd "$CACHE" && apt-get download "$pkg" >&2); then
       if [[ "$(id -u)" == 0 ]]; then
