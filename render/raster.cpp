@@ -22,6 +22,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -127,7 +128,7 @@ inline int64_t floorDiv(int64_t a, int64_t b) {
 // edge goes to exactly one of the two triangles (no double coverage, no crack), for either input
 // winding. The rule becomes an integer bias: inside <=> E + bias >= 0 with bias = 0 for top-left
 // edges (E >= 0) and -1 otherwise (E > 0 <=> E - 1 >= 0 for integers).
-[[maybe_unused]] inline bool isTopLeft(int64_t dx, int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
+inline bool isTopLeft(int64_t dx, int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
 
 struct EdgeSetup {
     int64_t value;  // E + bias at the first center of the box
@@ -142,7 +143,9 @@ inline EdgeSetup setupEdge(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64
     // top-left (dy < 0, or dy == 0 and dx > 0; |dx| < 2^31 by kMaxFixed), so bias = ~(t >> 63)
     // is 0 for top-left edges and -1 otherwise (isTopLeft states the same rule plainly).
     const int64_t t = dy * (int64_t(1) << 32) - dx;
-    e.value = dx * (sy - ay) - dy * (sx - ax) + ~(t >> 63);
+    const int64_t bias = ~(t >> 63);
+    assert((bias == 0) == isTopLeft(dx, dy));
+    e.value = dx * (sy - ay) - dy * (sx - ax) + bias;
     e.stepX = -dy * kSubpixelOne;
     e.stepY = dx * kSubpixelOne;
     return e;
