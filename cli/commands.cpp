@@ -4,7 +4,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <algorithm>
 #include <exception>
+#include <filesystem>
+#include <sstream>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -14,9 +17,12 @@
 #include <CLI/CLI.hpp>
 
 #include "analysis/demo.h"
+#include "analysis/depth_audit.h"
 #include "analysis/load.h"
 #include "analysis/pipeline.h"
 #include "reports/console.h"
+#include "reports/depth_audit_report.h"
+#include "reports/depth_plot.h"
 #include "reports/report.h"
 
 namespace va {
@@ -34,6 +40,10 @@ struct Options {
     uint32_t chunk = 512;
     bool noBackface = false, noFrustum = false;
     bool quiet = false;
+    // depth-audit
+    double nearZ = 0, farZ = 0;
+    std::string formats;  // comma-separated; empty = all
+    std::string auditOut; // empty = console only
 };
 
 void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
@@ -179,6 +189,58 @@ int cmdAnalyze(const Options &o) {
     return kExitOk;
 }
 
+int cmdDepthAudit(const Options &o) {
+    std::string err;
+    if (!validateDepthAuditRange(o.nearZ, o.farZ, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    std::vector<DepthFormat> formats;
+    if (o.formats.empty()) {
+        formats = allDepthFormats();
+    } else {
+        std::stringstream ss(o.formats);
+        std::string name;
+        while (std::getline(ss, name, ',')) {
+            DepthFormat f;
+            if (!parseDepthFormat(name, &f, &err)) {
+                fail("--formats: " + err);
+                return kExitBadInput;
+            }
+            formats.push_back(f);
+        }
+    }
+    const DepthAuditResult r = auditDepthFormats(o.nearZ, o.farZ, formats);
+    if (!r.error.empty()) {
+        fail(r.error);
+        return kExitBadInput;
+    }
+    std::printf("%s", depthAuditTable(r).c_str());
+    if (!o.auditOut.empty()) {
+        // The two files go into DIR one by one, each written atomically; DIR may hold a report.
+        std::error_code ec;
+        std::filesystem::create_directories(o.auditOut, ec);
+        if (ec) {
+            fail("cannot create --out folder '" + o.auditOut + "': " + ec.message());
+            return kExitBadInput;
+        }
+        if (!writeFileAtomic(o.auditOut + "/depth-audit.json", depthAuditJson(r).dump(2) + "\n", &err) ||
+            !writeDepthResolutionPlot(r, o.auditOut + "/depth-audit.png", &err)) {
+            fail(err);
+            return kExitBadInput;
+        }
+        std::printf("wrote %s/depth-audit.json and %s/depth-audit.png\n", o.auditOut.c_str(), o.auditOut.c_str());
+    }
+    return kExitOk;
+}
+
+void addDepthAuditOptions(CLI::App *c, Options &o) {
+    c->add_option("--near", o.nearZ, "Near plane distance (> 0)")->required();
+    c->add_option("--far", o.farZ, "Far plane distance (> near)")->required();
+    c->add_option("--formats", o.formats, "Comma-separated depth formats (default: all)");
+    c->add_option("--out", o.auditOut, "Folder for depth-audit.json and depth-audit.png");
+}
+
 void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("scene", o.scene, "Scene file: .json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb; "
                                     "none = the built-in demo");
@@ -213,11 +275,46 @@ const Command kCommands[] = {
      cmdInfo},
     {"analyze", "Run every stage for every view; write report.json and images to --out", addAnalyzeOptions,
      cmdAnalyze},
+    {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
+     addDepthAuditOptions, cmdDepthAudit},
 };
+
+// Levenshtein distance, for "did you mean" suggestions.
+size_t editDistance(const std::string &a, const std::string &b) {
+    std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        cur[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j)
+            cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+        std::swap(prev, cur);
+    }
+    return prev[b.size()];
+}
 
 }  // namespace
 
 int runCli(int argc, char **argv) {
+    // An unknown command gets ninja's treatment: name it, and suggest the nearest one.
+    if (argc > 1 && argv[1][0] != '-') {
+        const std::string name = argv[1];
+        const Command *best = nullptr;
+        size_t bestDistance = 3;  // suggest only close matches
+        bool known = false;
+        for (const Command &c : kCommands) {
+            known |= name == c.name;
+            const size_t d = editDistance(name, c.name);
+            if (d < bestDistance) bestDistance = d, best = &c;
+        }
+        if (!known) {
+            std::string msg = "unknown command '" + name + "'";
+            if (best) msg += ", did you mean '" + std::string(best->name) + "'?";
+            msg += " (commands:";
+            for (const Command &c : kCommands) msg += std::string(" ") + c.name;
+            fail(msg + "; see visaudit --help)");
+            return kExitBadInput;
+        }
+    }
     CLI::App app{"visaudit " VISAUDIT_VERSION " - scene-visibility analyzer and report generator"};
     app.set_version_flag("--version", "visaudit " VISAUDIT_VERSION);
     app.require_subcommand(1);

@@ -1,0 +1,235 @@
+// End to end: the program as a user runs it. Exit codes, messages, outputs, and that bad input
+// never leaves a partial report or damages an existing one.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "reports/report.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RunResult {
+    int code = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path &p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+class CliTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() / ("visaudit-cli-" + std::to_string(getpid()) + "-" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    // Runs the program with `args` (already shell-quoted where needed), no stdin.
+    RunResult run(const std::string &args) {
+        const fs::path o = dir_ / "stdout.txt", e = dir_ / "stderr.txt";
+        const std::string cmd = std::string(VISAUDIT_BINARY) + " " + args + " </dev/null >" + o.string() + " 2>" +
+                                e.string();
+        const int status = std::system(cmd.c_str());
+        RunResult r;
+        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        r.out = slurp(o);
+        r.err = slurp(e);
+        return r;
+    }
+    fs::path dir_;
+};
+
+const std::string kExamples = VISAUDIT_EXAMPLES;
+const std::string kData = VISAUDIT_TEST_DATA;
+
+}  // namespace
+
+TEST_F(CliTest, AnalyzeDemoWritesReportAndImages) {
+    const fs::path out = dir_ / "report";
+    const RunResult r = run("analyze --quiet --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(slurp(out / "report.json"));
+    EXPECT_EQ(j["format"], "visaudit-report/1");
+    EXPECT_EQ(j["tool"]["version"], VISAUDIT_VERSION);
+    ASSERT_EQ(j["views"].size(), 2u);
+    for (const char *v : {"spawn", "overview"})
+        for (const char *ext : {".depth.exr", ".depth.png", ".overdraw.png", ".ids.exr"})
+            EXPECT_TRUE(fs::exists(out / (std::string(v) + ext))) << v << ext;
+    // The ids image agrees with the report: covered pixels = pixels with a non-zero id.
+    va::ImageData img;
+    std::string err;
+    ASSERT_TRUE(va::readImage((out / "spawn.ids.exr").string(), &img, &err)) << err;
+    ASSERT_EQ(img.width, 960);
+    uint64_t covered = 0;
+    for (uint32_t v : img.u32) covered += v != 0;
+    EXPECT_EQ(covered, j["views"][0]["zbuffer"]["covered_pixels"].get<uint64_t>());
+    // No staging folder is left behind.
+    for (const auto &e : fs::directory_iterator(dir_))
+        EXPECT_EQ(e.path().filename().string().find("report.tmp"), std::string::npos) << e.path();
+}
+
+TEST_F(CliTest, AnalyzeIsDeterministicAcrossThreadCounts) {
+    const fs::path a = dir_ / "a", b = dir_ / "b";
+    ASSERT_EQ(run("analyze --quiet --threads 1 --out " + a.string()).code, 0);
+    ASSERT_EQ(run("analyze --quiet --threads 2 --out " + b.string()).code, 0);
+    for (const char *f : {"spawn.ids.exr", "spawn.depth.exr", "overview.overdraw.png", "overview.ids.exr"})
+        EXPECT_EQ(slurp(a / f), slurp(b / f)) << f;
+    auto strip = [](nlohmann::json j) {
+        // Timings differ between runs; everything else must not.
+        std::function<void(nlohmann::json &)> rec = [&](nlohmann::json &x) {
+            if (x.is_object()) {
+                for (auto it = x.begin(); it != x.end();) {
+                    const std::string k = it.key();
+                    if (k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0))
+                        it = x.erase(it);
+                    else
+                        rec(*it++);
+                }
+            } else if (x.is_array()) {
+                for (auto &e : x) rec(e);
+            }
+        };
+        rec(j);
+        return j;
+    };
+    EXPECT_EQ(strip(nlohmann::json::parse(slurp(a / "report.json"))),
+              strip(nlohmann::json::parse(slurp(b / "report.json"))));
+}
+
+TEST_F(CliTest, AnalyzeExampleSceneObjAndViewsFile) {
+    RunResult r = run("analyze " + kExamples + "/hall.scene.json --quiet --width 320 --height 180 --out " +
+                (dir_ / "hall").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    r = run("analyze " + kExamples + "/hall.scene.json --views " + kExamples +
+            "/hall.views.json --quiet --width 320 --height 180 --out " + (dir_ / "hall2").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(slurp(dir_ / "hall2" / "report.json"));
+    EXPECT_EQ(j["views"].size(), 3u);
+    // A mesh file analysed directly, with generated views.
+    r = run("analyze " + kExamples + "/meshes/hall.obj --views orbit:3 --quiet --width 320 --height 180 --out " +
+            (dir_ / "obj").string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    const auto k = nlohmann::json::parse(slurp(dir_ / "obj" / "report.json"));
+    EXPECT_EQ(k["views"].size(), 3u);
+    EXPECT_GT(k["views"][0]["zbuffer"]["covered_pixels"].get<uint64_t>(), 0u);
+}
+
+TEST_F(CliTest, AnalyzeRealLevels) {
+    const std::string dungeon = kData + "/castle/level/level-dungeon.gltf";
+    const std::string elephant = kData + "/cgal/elephant.off";
+    if (!fs::exists(dungeon) || !fs::exists(elephant))
+        GTEST_SKIP() << "real data not fetched (run scripts/fetch-data.sh)";
+    RunResult r = run("analyze " + dungeon + " --views orbit:2 --quiet --width 640 --height 360 --out " +
+                (dir_ / "d").string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto j = nlohmann::json::parse(slurp(dir_ / "d" / "report.json"));
+    EXPECT_EQ(j["scene"]["triangles"], 25038);
+    EXPECT_GT(j["views"][0]["zbuffer"]["covered_pixels"].get<uint64_t>(), 1000u);
+    r = run("analyze " + elephant + " --views orbit:2 --quiet --width 640 --height 360 --out " +
+            (dir_ / "e").string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    j = nlohmann::json::parse(slurp(dir_ / "e" / "report.json"));
+    EXPECT_EQ(j["scene"]["triangles"], 5558);
+    // A closed mesh: without backface culling every back face covers the silhouette again, so
+    // the fragments grow by more than half.
+    r = run("analyze " + elephant + " --views orbit:2 --quiet --width 640 --height 360 --no-backface --out " +
+            (dir_ / "e2").string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto k = nlohmann::json::parse(slurp(dir_ / "e2" / "report.json"));
+    const uint64_t culled = j["views"][0]["zbuffer"]["fragments"], all = k["views"][0]["zbuffer"]["fragments"];
+    EXPECT_GT(double(all), 1.5 * double(culled));
+    EXPECT_EQ(j["views"][0]["zbuffer"]["covered_pixels"], k["views"][0]["zbuffer"]["covered_pixels"]);
+}
+
+TEST_F(CliTest, BadInputExitsTwoWithAClearMessageAndNoReport) {
+    const fs::path out = dir_ / "out";
+    struct Case {
+        std::string args, message;
+    };
+    const std::vector<Case> cases = {
+        {"analyze /nonexistent/level.json", "/nonexistent/level.json"},
+        {"analyze --views orbit:0", "--views orbit:0: expected orbit:N with N a whole number from 1 to 100000"},
+        {"analyze --width 100000", "exceeds the limit of 16384 pixels per side"},
+        {"analyze --depth-format f16", "unknown depth format 'f16'; known formats: linear_f32"},
+        {"analyze --views /nonexistent/views.json", "/nonexistent/views.json"},
+        {"analyse", "unknown command 'analyse', did you mean 'analyze'?"},
+    };
+    for (const Case &c : cases) {
+        const RunResult r = run(c.args + " --out " + out.string());
+        EXPECT_EQ(r.code, 2) << c.args << "\n" << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\nstderr: " << r.err;
+        EXPECT_FALSE(fs::exists(out)) << c.args;
+    }
+    // Malformed JSON: the file, line and column.
+    const fs::path bad = dir_ / "bad.scene.json";
+    std::ofstream(bad) << "{\n  \"format\": \"visaudit-scene/1\",\n  \"objects\": [ }\n";
+    const RunResult r = run("analyze " + bad.string() + " --out " + out.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(bad.string() + ":3:"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(CliTest, FailedRunKeepsTheExistingReportAndOtherFoldersAreNeverReplaced) {
+    const fs::path out = dir_ / "out";
+    ASSERT_EQ(run("analyze --quiet --out " + out.string()).code, 0);
+    const std::string before = slurp(out / "report.json");
+    // A run that fails on bad input leaves the previous report exactly as it was.
+    EXPECT_EQ(run("analyze --width 100000 --out " + out.string()).code, 2);
+    EXPECT_EQ(slurp(out / "report.json"), before);
+    // A folder that is not a visaudit report is refused, untouched.
+    const fs::path mine = dir_ / "mine";
+    fs::create_directories(mine);
+    std::ofstream(mine / "notes.txt") << "precious";
+    const RunResult r = run("analyze --quiet --out " + mine.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(mine.string()), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(mine / "notes.txt"), "precious");
+    EXPECT_FALSE(fs::exists(mine / "report.json"));
+}
+
+TEST_F(CliTest, InfoSummarizesTheExampleScene) {
+    const RunResult r = run("info " + kExamples + "/hall.scene.json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("materials"), std::string::npos);
+    EXPECT_NE(r.out.find("spawn"), std::string::npos);
+    EXPECT_NE(r.out.find("double-sided"), std::string::npos);
+}
+
+TEST_F(CliTest, DepthAuditPrintsTheTableAndWritesJsonAndPlot) {
+    const fs::path out = dir_ / "audit";
+    const RunResult r = run("depth-audit --near 0.1 --far 10000 --out " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("unorm16             16        65536"), std::string::npos) << r.out;
+    const auto j = nlohmann::json::parse(slurp(out / "depth-audit.json"));
+    EXPECT_EQ(j["format"], "visaudit-depth-audit/1");
+    va::ImageData img;
+    std::string err;
+    ASSERT_TRUE(va::readImage((out / "depth-audit.png").string(), &img, &err)) << err;
+    EXPECT_EQ(img.width, 1200);
+    // Bad ranges and names: exit 2 with the value named.
+    RunResult b = run("depth-audit --near 0 --far 10");
+    EXPECT_EQ(b.code, 2);
+    EXPECT_NE(b.err.find("near plane 0"), std::string::npos) << b.err;
+    b = run("depth-audit --near 10 --far 1");
+    EXPECT_EQ(b.code, 2);
+    b = run("depth-audit --near 1 --far 10 --formats f32,f16");
+    EXPECT_EQ(b.code, 2);
+    EXPECT_NE(b.err.find("unknown depth format 'f16'"), std::string::npos) << b.err;
+}
