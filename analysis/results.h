@@ -42,6 +42,8 @@ struct BackfaceStats {
 };
 
 struct ViewResult {
+    size_t index = 0;                 // position in the full view list (before --shard selection)
+    std::string imageBase;            // file-name base of its images (empty: derived from the name)
     ViewSpec spec;
     Camera camera;
     std::vector<StageRecord> stages;  // in DESIGN.md's fixed order
@@ -61,6 +63,11 @@ struct AnalysisResult {
     uint64_t sourceObjects = 0;
     Aabb bounds;
     double loadMs = 0;
+    // --shard K/N: this report holds the views whose index i has i % N == K - 1.
+    struct Shard {
+        int index = 1, count = 1;     // K and N (1-based K); 1/1 = every view
+        size_t viewsTotal = 0;        // views before the selection
+    } shard;
     std::vector<ViewResult> views;
 };
 

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "analysis/demo.h"
 #include "analysis/depth_audit.h"
@@ -23,6 +24,7 @@
 #include "reports/console.h"
 #include "reports/depth_audit_report.h"
 #include "reports/depth_plot.h"
+#include "reports/merge.h"
 #include "reports/report.h"
 
 namespace va {
@@ -44,6 +46,8 @@ struct Options {
     double nearZ = 0, farZ = 0;
     std::string formats;  // comma-separated; empty = all
     std::string auditOut; // empty = console only
+    std::string shard;    // analyze --shard K/N
+    std::vector<std::string> mergeDirs;
 };
 
 void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
@@ -146,6 +150,30 @@ int cmdAnalyze(const Options &o) {
     const double loadMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 
     std::string err;
+    // Image names are fixed over the full view list before any selection or parallel run, so
+    // colliding view names stay distinct and every shard names a view's images the same way.
+    const std::vector<std::string> allBases = imageBaseNames(views);
+    AnalysisResult result;
+    result.shard.viewsTotal = views.size();
+    std::vector<size_t> indices;  // positions in the full list of the views this run analyses
+    if (!o.shard.empty()) {
+        if (!parseShard(o.shard, &result.shard.index, &result.shard.count, &err)) {
+            fail(err);
+            return kExitBadInput;
+        }
+        for (size_t i = size_t(result.shard.index - 1); i < views.size(); i += size_t(result.shard.count))
+            indices.push_back(i);
+    } else {
+        for (size_t i = 0; i < views.size(); ++i) indices.push_back(i);
+    }
+    std::vector<ViewSpec> selected;
+    std::vector<std::string> bases;
+    for (size_t i : indices) {
+        selected.push_back(views[i]);
+        bases.push_back(allBases[i]);
+    }
+    views = std::move(selected);
+
     OutputDir out;
     if (!out.open(o.out, &err)) {
         fail(err);
@@ -154,10 +182,9 @@ int cmdAnalyze(const Options &o) {
     const bool tty = isatty(fileno(stderr));
     std::atomic<int> done{0};
     std::mutex printMutex;
-    AnalysisResult result;
-    // Image names are fixed before the parallel run, so colliding view names stay distinct.
-    const std::vector<std::string> bases = imageBaseNames(views);
     auto onView = [&](size_t i, ViewResult &v, std::string *e) {
+        v.index = indices[i];
+        v.imageBase = bases[i];
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
         v.buffer = ZBuffer{};  // the images hold it now
         const int k = ++done;
@@ -187,6 +214,35 @@ int cmdAnalyze(const Options &o) {
         std::printf("report: %s/report.json\n", o.out.c_str());
     }
     return kExitOk;
+}
+
+int cmdMerge(const Options &o) {
+    std::string err;
+    OutputDir out;
+    if (!out.open(o.out, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    nlohmann::ordered_json merged;
+    if (!mergeReports(o.mergeDirs, out.staging(), &merged, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (!writeFileAtomic(out.staging() + "/report.json", merged.dump(2) + "\n", &err) || !out.commit(&err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (!err.empty()) std::fprintf(stderr, "visaudit: warning: %s\n", err.c_str());
+    if (!o.quiet)
+        std::printf("merged %zu shards, %zu views: %s/report.json\n", o.mergeDirs.size(), merged["views"].size(),
+                    o.out.c_str());
+    return kExitOk;
+}
+
+void addMergeOptions(CLI::App *c, Options &o) {
+    c->add_option("shards", o.mergeDirs, "The --out folders of every analyze --shard K/N run")->required();
+    c->add_option("--out", o.out, "Output folder for the merged report (written as a whole or not at all)");
+    c->add_flag("--quiet", o.quiet, "No summary on the console");
 }
 
 int cmdDepthAudit(const Options &o) {
@@ -261,6 +317,8 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-backface", o.noBackface, "Turn the backface stage off");
     c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
+    c->add_option("--shard", o.shard, "Analyse only shard K of N: the views whose index i has i % N == K - 1 "
+                                      "(join the shards with visaudit merge)");
 }
 
 struct Command {
@@ -275,6 +333,7 @@ const Command kCommands[] = {
      cmdInfo},
     {"analyze", "Run every stage for every view; write report.json and images to --out", addAnalyzeOptions,
      cmdAnalyze},
+    {"merge", "Join the reports of analyze --shard K/N runs into one report", addMergeOptions, cmdMerge},
     {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
      addDepthAuditOptions, cmdDepthAudit},
 };

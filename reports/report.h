@@ -17,6 +17,8 @@ constexpr const char *kReportFormat = "visaudit-report/1";
 // Doubles are always finite: a value that is not (an empty scene's bounds, a ratio over zero
 // pixels) is written as null; docs/report-schema.json says which fields can be null.
 nlohmann::ordered_json reportJson(const AnalysisResult &result);
+// The report's "totals" computed from its "views" array alone (reportJson and merge share it).
+nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views);
 
 // ---- Image file names ------------------------------------------------------------------------
 // A view name made safe as a file name: [A-Za-z0-9._-] kept, every other byte replaced by '_'

@@ -197,13 +197,8 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
     scene["bounds"] = {{"min", vec3(r.bounds.lo)}, {"max", vec3(r.bounds.hi)}};
     j["scene"] = scene;
     j["load_ms"] = num(r.loadMs);
-
-    // Totals over views: per-stage culled triangles (stages in order of first appearance, which is
-    // DESIGN.md's fixed order), z-buffer sums.
-    std::vector<std::string> stageOrder;
-    std::map<std::string, uint64_t> culled;
-    uint64_t covered = 0, fragments = 0, passes = 0;
-    double totalMs = 0;
+    j["shard"] = {{"index", r.shard.index}, {"count", r.shard.count},
+                  {"views_total", r.shard.viewsTotal ? r.shard.viewsTotal : r.views.size()}};
 
     const std::vector<std::string> bases = imageBaseNames(r.views);
     Json views = Json::array();
@@ -211,6 +206,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
         const ViewResult &v = r.views[i];
         Json vj;
         vj["name"] = v.spec.name;
+        vj["index"] = v.index;
         vj["origin"] = v.spec.origin;
         vj["width"] = v.spec.camera.width;
         vj["height"] = v.spec.camera.height;
@@ -220,28 +216,43 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
         Json stages = Json::array();
         for (const StageRecord &s : v.stages) {
             stages.push_back(stageJson(s, v));
-            if (!culled.count(s.name)) stageOrder.push_back(s.name);
-            culled[s.name] += s.trianglesCulled;
         }
         vj["stages"] = stages;
         vj["zbuffer"] = zbufferJson(v.zbuffer);
-        const ViewImageNames names = viewImageNames(bases[i]);
+        const ViewImageNames names = viewImageNames(v.imageBase.empty() ? bases[i] : v.imageBase);
         vj["images"] = {{"depth_exr", names.depthExr},
                         {"depth_png", names.depthPng},
                         {"overdraw_png", names.overdrawPng},
                         {"ids_exr", names.idsExr}};
         vj["total_ms"] = num(v.totalMs);
         views.push_back(vj);
-
-        covered += v.zbuffer.coveredPixels;
-        fragments += v.zbuffer.fragments;
-        passes += v.zbuffer.depthPasses;
-        totalMs += v.totalMs;
     }
     j["views"] = views;
+    j["totals"] = reportTotals(j["views"]);
+    return j;
+}
 
+// Totals over views, computed from the views' JSON alone, so that `merge` recomputes exactly what a
+// single run writes: per-stage culled triangles (stages in order of first appearance, which is
+// DESIGN.md's fixed order), z-buffer sums.
+nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
+    std::vector<std::string> stageOrder;
+    std::map<std::string, uint64_t> culled;
+    uint64_t covered = 0, fragments = 0, passes = 0;
+    double totalMs = 0;
+    for (const Json &v : views) {
+        for (const Json &s : v["stages"]) {
+            const std::string name = s["name"];
+            if (!culled.count(name)) stageOrder.push_back(name);
+            culled[name] += s["triangles_culled"].get<uint64_t>();
+        }
+        covered += v["zbuffer"]["covered_pixels"].get<uint64_t>();
+        fragments += v["zbuffer"]["fragments"].get<uint64_t>();
+        passes += v["zbuffer"]["depth_passes"].get<uint64_t>();
+        if (v["total_ms"].is_number()) totalMs += v["total_ms"].get<double>();
+    }
     Json totals;
-    totals["views"] = r.views.size();
+    totals["views"] = views.size();
     Json culledJson = Json::object();
     for (const std::string &name : stageOrder) culledJson[name] = culled[name];
     totals["triangles_culled"] = culledJson;
@@ -249,8 +260,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
     totals["fragments"] = fragments;
     totals["depth_passes"] = passes;
     totals["total_ms"] = num(totalMs);
-    j["totals"] = totals;
-    return j;
+    return totals;
 }
 
 }  // namespace va

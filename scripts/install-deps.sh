@@ -7,8 +7,9 @@ PACKAGES=(
   build-essential cmake pkg-config ca-certificates
   libopenmesh-dev libembree-dev libcgal-dev libgmp-dev libmpfr-dev
   libopenimageio-dev nlohmann-json3-dev libcli11-dev libtbb-dev
-  libtinygltf-dev libstb-dev
+  libtinygltf-dev libstb-dev libzip-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  parallel
 )
 
 missing=()

@@ -233,3 +233,54 @@ TEST_F(CliTest, DepthAuditPrintsTheTableAndWritesJsonAndPlot) {
     EXPECT_EQ(b.code, 2);
     EXPECT_NE(b.err.find("unknown depth format 'f16'"), std::string::npos) << b.err;
 }
+
+TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
+    if (std::system("command -v parallel >/dev/null 2>&1") != 0)
+        GTEST_SKIP() << "GNU parallel is not installed (scripts/install-deps.sh installs it)";
+    const std::string common = " analyze " + kExamples + "/hall.scene.json --views orbit:9 --width 160 --height 90 --quiet";
+    ASSERT_EQ(run(common + " --out " + (dir_ / "single").string()).code, 0);
+    // The README's recipe: one job per shard, any order, two at a time.
+    const std::string cmd = "parallel -j2 --halt now,fail=1 " + std::string(VISAUDIT_BINARY) + common +
+                            " --shard {}/4 --out " + (dir_ / "shard{}").string() + " ::: 1 2 3 4";
+    ASSERT_EQ(std::system((cmd + " </dev/null >/dev/null 2>&1").c_str()), 0) << cmd;
+    const RunResult m = run("merge " + (dir_ / "shard1").string() + " " + (dir_ / "shard3").string() + " " +
+                            (dir_ / "shard2").string() + " " + (dir_ / "shard4").string() + " --out " +
+                            (dir_ / "merged").string());
+    ASSERT_EQ(m.code, 0) << m.err;
+    std::function<void(nlohmann::json &)> strip = [&](nlohmann::json &x) {
+        if (x.is_object()) {
+            for (auto it = x.begin(); it != x.end();) {
+                const std::string k = it.key();
+                if (k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0))
+                    it = x.erase(it);
+                else
+                    strip(*it++);
+            }
+        } else if (x.is_array()) {
+            for (auto &e : x) strip(e);
+        }
+    };
+    auto single = nlohmann::json::parse(slurp(dir_ / "single" / "report.json"));
+    auto merged = nlohmann::json::parse(slurp(dir_ / "merged" / "report.json"));
+    strip(single);
+    strip(merged);
+    EXPECT_EQ(single, merged);
+    // Every image is byte-identical too.
+    size_t images = 0;
+    for (const auto &e : fs::directory_iterator(dir_ / "single")) {
+        if (e.path().filename() == "report.json") continue;
+        ++images;
+        EXPECT_EQ(slurp(e.path()), slurp(dir_ / "merged" / e.path().filename())) << e.path();
+    }
+    EXPECT_EQ(images, 9u * 4u);
+    // Missing and overlapping shards are refused.
+    RunResult bad = run("merge " + (dir_ / "shard1").string() + " " + (dir_ / "shard2").string() + " --out " +
+                        (dir_ / "bad").string());
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("shard 3/4 is missing"), std::string::npos) << bad.err;
+    bad = run("merge " + (dir_ / "shard1").string() + " " + (dir_ / "shard1").string() + " --out " +
+              (dir_ / "bad").string());
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("shards overlap"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(dir_ / "bad"));
+}

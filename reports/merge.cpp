@@ -1,0 +1,154 @@
+#include "reports/merge.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "reports/report.h"
+
+namespace va {
+
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+
+bool parseShard(const std::string &text, int *index, int *count, std::string *err) {
+    const size_t slash = text.find('/');
+    auto whole = [](const std::string &s, long *v) {
+        if (s.empty() || s.size() > 6 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+        *v = std::stol(s);
+        return true;
+    };
+    long k = 0, n = 0;
+    if (slash == std::string::npos || !whole(text.substr(0, slash), &k) || !whole(text.substr(slash + 1), &n) ||
+        n < 1 || n > 100000 || k < 1 || k > n) {
+        *err = "--shard " + text + ": expected K/N with 1 <= K <= N <= 100000, e.g. --shard 2/4 (shard 2 of 4)";
+        return false;
+    }
+    *index = int(k);
+    *count = int(n);
+    return true;
+}
+
+namespace {
+
+bool readReport(const std::string &dir, Json *out, std::string *err) {
+    const std::string path = (fs::path(dir) / "report.json").string();
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        *err = path + ": cannot be read; give the --out folder of an `analyze --shard K/N` run";
+        return false;
+    }
+    std::stringstream ss;
+    ss << f.rdbuf();
+    try {
+        *out = Json::parse(ss.str());
+    } catch (const std::exception &e) {
+        *err = path + ": not valid JSON (" + e.what() + ")";
+        return false;
+    }
+    if (!out->is_object() || !out->contains("format") || (*out)["format"] != kReportFormat) {
+        *err = path + ": not a " + std::string(kReportFormat) + " report; merge joins reports of this visaudit version";
+        return false;
+    }
+    for (const char *key : {"tool", "scene", "shard", "views"})
+        if (!out->contains(key)) {
+            *err = path + ": has no \"" + key + "\"; was it written by visaudit analyze?";
+            return false;
+        }
+    return true;
+}
+
+}  // namespace
+
+bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDir, Json *merged, std::string *err) {
+    if (dirs.empty()) {
+        *err = "merge needs the folders of the shard reports, e.g. visaudit merge shard1 shard2 --out merged";
+        return false;
+    }
+    std::vector<Json> reports(dirs.size());
+    for (size_t i = 0; i < dirs.size(); ++i)
+        if (!readReport(dirs[i], &reports[i], err)) return false;
+
+    // One analysis: same tool version, same scene, same shard count and view count.
+    const Json &first = reports[0];
+    const int count = first["shard"]["count"];
+    const size_t total = first["shard"]["views_total"];
+    std::map<int, size_t> byIndex;  // shard K -> folder
+    for (size_t i = 0; i < reports.size(); ++i) {
+        const Json &r = reports[i];
+        auto mismatch = [&](const char *what) {
+            *err = dirs[i] + ": " + what + " differs from " + dirs[0] + "'s; merge only shards of one analysis";
+            return false;
+        };
+        if (r["tool"] != first["tool"]) return mismatch("the visaudit version");
+        if (r["scene"] != first["scene"]) return mismatch("the scene");
+        if (r["shard"]["count"] != count) return mismatch("the shard count N");
+        if (r["shard"]["views_total"] != total) return mismatch("the number of views");
+        const int k = r["shard"]["index"];
+        if (byIndex.count(k)) {
+            *err = "shards overlap: " + dirs[byIndex[k]] + " and " + dirs[i] + " are both shard " + std::to_string(k) +
+                   "/" + std::to_string(count) + "; give each shard once";
+            return false;
+        }
+        byIndex[k] = i;
+    }
+    for (int k = 1; k <= count; ++k)
+        if (!byIndex.count(k)) {
+            *err = "shard " + std::to_string(k) + "/" + std::to_string(count) +
+                   " is missing; run analyze --shard " + std::to_string(k) + "/" + std::to_string(count) +
+                   " and give its folder too";
+            return false;
+        }
+
+    // Every view exactly once, each in the shard that owns its index.
+    std::vector<const Json *> views(total, nullptr);
+    std::vector<size_t> owner(total, 0);
+    for (size_t i = 0; i < reports.size(); ++i)
+        for (const Json &v : reports[i]["views"]) {
+            const size_t idx = v["index"];
+            const int k = reports[i]["shard"]["index"];
+            if (idx >= total || int(idx % size_t(count)) != k - 1 || views[idx]) {
+                *err = dirs[i] + "/report.json: view '" + v["name"].get<std::string>() + "' (index " +
+                       std::to_string(idx) + ") does not belong to shard " + std::to_string(k) + "/" +
+                       std::to_string(count) + " or appears twice";
+                return false;
+            }
+            views[idx] = &v;
+            owner[idx] = i;
+        }
+    for (size_t idx = 0; idx < total; ++idx)
+        if (!views[idx]) {
+            *err = "view " + std::to_string(idx) + " is in no shard report; re-run its shard";
+            return false;
+        }
+
+    // Images: copy every file a view lists.
+    for (size_t idx = 0; idx < total; ++idx)
+        for (const auto &[key, name] : (*views[idx])["images"].items()) {
+            if (!name.is_string()) continue;
+            const fs::path src = fs::path(dirs[owner[idx]]) / name.get<std::string>();
+            std::error_code ec;
+            fs::copy_file(src, fs::path(outDir) / name.get<std::string>(), fs::copy_options::overwrite_existing, ec);
+            if (ec) {
+                *err = src.string() + ": cannot copy (" + ec.message() + ")";
+                return false;
+            }
+        }
+
+    Json m;
+    for (const auto &[key, value] : first.items()) {
+        if (key == "views" || key == "totals") continue;
+        m[key] = value;
+    }
+    m["shard"] = {{"index", 1}, {"count", 1}, {"views_total", total}};
+    Json list = Json::array();
+    for (const Json *v : views) list.push_back(*v);
+    m["views"] = list;
+    m["totals"] = reportTotals(m["views"]);
+    *merged = std::move(m);
+    return true;
+}
+
+}  // namespace va
