@@ -1,44 +1,27 @@
 // The z-buffer rasterizer (raster.h; decisions in docs/rasterizer.md).
 //
-// Structure: rasterize() clears the buffers, then dispatches once on (depth format, projection) to
-// rasterizeTriangles<F, kPerspective>, whose per-fragment depth encoding is therefore inlined and
-// branch-free. Per triangle:
-//   1. orientation: twice the signed area in fixed point; zero -> empty, negative -> swap v1, v2 so
-//      every triangle is walked with the same winding and the same inside test;
-//   2. the bounding box of the *pixel centers* it may cover, clamped to the viewport; empty box ->
-//      done (the common case for the benchmark scene's sub-pixel triangles: no edge setup at all);
-//   3. edge functions in int64 at the first center, stepped exactly by integer increments;
-//   4. coverage, by the size of the box (all four give the same set of centers, exactly):
-//      - small (box <= 8 x 8 centers, vertex extent <= 64 px): one 4 x 4 or 8 x 8 block of inside
-//        tests in 32-bit SIMD lanes into a bit mask, without data-dependent branches;
-//      - wide (box >= kSpanMinWidth): each row's covered span solved with integer floor division,
-//        so large triangles cost per row, not per empty center of their box;
-//      - otherwise: every center of the box, stepping the edge functions;
-//   5. per covered center: view depth straight from the DepthPlane (never stepped), encode, LESS
-//      written as selects (no branch on the depth test's outcome).
-// Designed to grow into SIMD over fragments and screen-space binning for threads: coverage ends in
-// a mask or a span, and the per-fragment step only needs (pixel, plane, id).
+// Structure: rasterize() clears the buffers, then dispatches once on (depth format, projection,
+// exactDepth) to the coverage walk of raster_core.h (forEachFragment) with the z-buffer as its
+// sink, so the per-fragment depth encoding is inlined and branch-free. The walk does orientation,
+// the box of pixel centers, int64 edge functions and the three coverage paths; the sink does, per
+// covered center, encode and LESS written as selects (no branch on the depth test's outcome), and
+// the per-triangle counts. The audits' options (single-sided winding, per-source fragment counts)
+// are tested once per triangle, never per fragment.
 #include "render/raster.h"
 
 #include <algorithm>
-#include <bit>
-#include <cassert>
 #include <cmath>
 #include <limits>
-#include <utility>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "render/depth_format_impl.h"
+#include "render/raster_core.h"
 
 namespace va {
 
 int32_t toFixed(double pixelCoordinate) {
     // Scaling by 2^kSubpixelBits is exact; nearbyint rounds half to even in the default mode.
     const double s = std::nearbyint(pixelCoordinate * kSubpixelOne);
-    // Saturate (NaN goes to the minimum): the rasterizer rejects such coordinates (kMaxFixed below).
+    // Saturate (NaN goes to the minimum): the rasterizer rejects such coordinates (kMaxFixed, raster_core.h).
     if (!(s > -2147483648.0)) return std::numeric_limits<int32_t>::min();
     if (s > 2147483647.0) return std::numeric_limits<int32_t>::max();
     return int32_t(s);
@@ -46,266 +29,82 @@ int32_t toFixed(double pixelCoordinate) {
 
 namespace {
 
-// Range of fixed-point coordinates the int64 edge functions hold without overflow. With
-// |x|, |y| <= 2^29 every vertex difference is below 2^30 + 2^29 < 2^31, each product of two
-// differences below 2^62, and the edge function (difference of two products, plus the bias) below
-// 2^63. That is 2^21 pixels (2 million) outside the viewport, far beyond the clipper's guard band
-// (ClipSettings::guardBandPixels = 8192, i.e. 2^21 in fixed point). Triangles beyond it violate the
-// clip stage's contract; they are skipped and counted as empty rather than risk a wrapped sign.
-constexpr int64_t kMaxFixed = int64_t(1) << 29;
+// The z-buffer as a fragment sink (raster_core.h). Instantiated per depth format and projection
+// (dispatchDepthFormat once per call), so encodeDepth<F> inlines; kExact compares the double depth
+// instead (the format is then not used per fragment). Accumulators live in the sink and are added
+// to the stats once at the end.
+template <DepthFormat F, bool kExact>
+struct ZBufferSink {
+    const DepthEncoder &enc;
+    const uint32_t *source;           // ScreenTriangles::source
+    const uint8_t *singleSided;       // settings.singleSided (may be null)
+    uint32_t *fragmentsPerSource;     // settings.fragmentsPerSource (may be null)
+    uint32_t *keyBuf;
+    uint32_t *idBuf;
+    double *depthBuf;
+    uint16_t *fragBuf;
+    uint16_t *passBuf;
+    // 1 + source of the current triangle, held as uint64_t: a uint32_t member could alias the
+    // uint32_t buffers written per fragment, forcing a reload after every store.
+    uint64_t idValue = 0;
+    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawn = 0, backWinding = 0;
 
-// Pixel x's sample (center) in fixed point is x * kSubpixelOne + kHalf.
-constexpr int64_t kHalf = kSubpixelOne / 2;
-
-// Small triangles: a box of at most 8 x 8 centers is tested as one block of 4 x 4 or 8 x 8 samples
-// in 32-bit lanes, when the vertex extent is at most kBlockExtent in both axes. 32 bits suffice
-// then: every sample of the block lies within the vertex box grown by 7 pixels (the box of centers
-// lies inside the vertex box), so |E| = |dx (sy - ay) - dy (sx - ax)| <= 2 ext (ext + 7 px) with
-// ext <= 64 px = 2^14: 2 * 2^14 * (2^14 + 1792) < 2^30; the bias and the steps stay below that.
-constexpr int64_t kBlockExtent = int64_t(64) << kSubpixelBits;
-constexpr uint64_t kRowStarts = 0x0101010101010101ull;  // bit 0 of each of 8 rows
-
-// Coverage bits (bit 8 row + column) of the kRows x kCols block whose first center has the edge
-// values r[k] (bias included), stepX/stepY as in EdgeSetup, all in int32 (see kBlockExtent).
-// No data-dependent branch: the loops have constant trip counts and unroll.
-template <int kRows, int kCols>
-inline uint64_t blockCoverage(const int32_t r[3], const int32_t stepX[3], const int32_t stepY[3]) {
-#if defined(__SSE2__)
-    // Lanes are columns; a center is outside when any edge value is negative, i.e. when the sign
-    // bit of e0 | e1 | e2 is set (movemask gathers four sign bits).
-    constexpr int kVecs = kCols / 4;
-    __m128i e[kVecs][3], dy[3];
-    for (int k = 0; k < 3; ++k) {
-        for (int v = 0; v < kVecs; ++v) {
-            const int32_t c = r[k] + 4 * v * stepX[k];  // column 4v
-            e[v][k] = _mm_set_epi32(c + 3 * stepX[k], c + 2 * stepX[k], c + stepX[k], c);
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const uint32_t src = source[t];
+        if (singleSided && singleSided[src] && !frontWinding) {
+            ++backWinding;
+            return false;
         }
-        dy[k] = _mm_set1_epi32(stepY[k]);
+        idValue = src + 1;
+        return true;
     }
-    uint64_t outside = 0;
-    for (int row = 0; row < kRows; ++row)
-        for (int v = 0; v < kVecs; ++v) {
-            const __m128i any = _mm_or_si128(_mm_or_si128(e[v][0], e[v][1]), e[v][2]);
-            outside |= uint64_t(_mm_movemask_ps(_mm_castsi128_ps(any))) << (8 * row + 4 * v);
-            for (int k = 0; k < 3; ++k) e[v][k] = _mm_add_epi32(e[v][k], dy[k]);
-        }
-    return ~outside;
-#else
-    uint64_t inside = 0;
-    for (int row = 0; row < kRows; ++row)
-        for (int col = 0; col < kCols; ++col) {
-            const int32_t e0 = r[0] + row * stepY[0] + col * stepX[0];
-            const int32_t e1 = r[1] + row * stepY[1] + col * stepX[1];
-            const int32_t e2 = r[2] + row * stepY[2] + col * stepX[2];
-            inside |= uint64_t((e0 | e1 | e2) >= 0) << (8 * row + col);
-        }
-    return inside;
-#endif
-}
 
-// Boxes at least this many pixels wide use the per-row span solver instead of scanning centers
-// (narrower ones that are not small blocks scan every center of the box).
-constexpr int64_t kSpanMinWidth = 12;
-
-// floor(a / b) for b > 0 (C++ division truncates toward zero).
-inline int64_t floorDiv(int64_t a, int64_t b) {
-    const int64_t q = a / b;
-    return q - ((a % b) < 0 ? 1 : 0);
-}
-
-// Top-left fill rule, for a triangle walked with positive signed area
-//   A = (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) > 0   (fixed point, y down: clockwise on screen).
-// The edge a -> b, with (dx, dy) = b - a, has the edge function
-//   E(p) = dx (p.y - a.y) - dy (p.x - a.x),
-// positive on the triangle's side (E_01(v2) = A > 0); its inward normal is (-dy, dx). A center with
-// E > 0 on all three edges is inside. A center with E == 0 lies exactly on the edge's line and
-// belongs to the triangle only if the edge is
-//   a left edge:  the interior lies at larger x   <=> -dy > 0 <=> dy < 0, or
-//   a top edge:   horizontal, interior below it (larger y on screen) <=> dy == 0 and dx > 0.
-// A neighbour sharing the edge has it with the opposite direction (-dx, -dy) once it is walked with
-// the same winding (both are oriented by the swap above), and exactly one of (dx, dy), (-dx, -dy)
-// satisfies "dy < 0 or (dy == 0 and dx > 0)" when the edge is not a point. So a center on a shared
-// edge goes to exactly one of the two triangles (no double coverage, no crack), for either input
-// winding. The rule becomes an integer bias: inside <=> E + bias >= 0 with bias = 0 for top-left
-// edges (E >= 0) and -1 otherwise (E > 0 <=> E - 1 >= 0 for integers).
-inline bool isTopLeft(int64_t dx, int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
-
-struct EdgeSetup {
-    int64_t value;  // E + bias at the first center of the box
-    int64_t stepX;  // change of E from one pixel center to the next one to the right
-    int64_t stepY;  // change of E from one row of centers to the next one down
-};
-
-inline EdgeSetup setupEdge(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64_t sx, int64_t sy) {
-    const int64_t dx = bx - ax, dy = by - ay;
-    EdgeSetup e;
-    // The bias without branches or flags: t = dy 2^32 - dx is negative exactly when the edge is
-    // top-left (dy < 0, or dy == 0 and dx > 0; |dx| < 2^31 by kMaxFixed), so bias = ~(t >> 63)
-    // is 0 for top-left edges and -1 otherwise (isTopLeft states the same rule plainly).
-    const int64_t t = dy * (int64_t(1) << 32) - dx;
-    const int64_t bias = ~(t >> 63);
-    assert((bias == 0) == isTopLeft(dx, dy));
-    e.value = dx * (sy - ay) - dy * (sx - ax) + bias;
-    e.stepX = -dy * kSubpixelOne;
-    e.stepY = dx * kSubpixelOne;
-    return e;
-}
-
-// The per-format, per-projection loop over all triangles (see the file comment for the steps).
-template <DepthFormat F, bool kPerspective>
-void rasterizeTriangles(const ScreenTriangles &tris, const DepthEncoder &enc, ZBuffer &zb, ZBufferStats &st) {
-    const int64_t W = zb.width, H = zb.height;
-    uint32_t *const keyBuf = zb.key.data();
-    uint32_t *const idBuf = zb.id.data();
-    double *const depthBuf = zb.depth.data();
-    uint16_t *const fragBuf = zb.fragments.data();
-    uint16_t *const passBuf = zb.passes.data();
-    const int32_t *const xy = tris.xy.data();
-    const uint32_t *const planeIndex = tris.plane.data();
-    const DepthPlane *const planes = tris.planes.data();
-
-    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawn = 0, empty = 0;
-    const size_t n = tris.size();
-    for (size_t t = 0; t < n; ++t) {
-        const int32_t *v = xy + 6 * t;
-        int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
-
-        // Bounding box of the pixel centers it may cover: x*one + half >= minX
-        // <=> x >= ceil((minX - half) / one) = (minX - half + one - 1) >> bits (arithmetic shift
-        // floors, also for negatives), and x*one + half <= maxX <=> x <= (maxX - half) >> bits.
-        const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
-        const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
-        const int64_t bx0 = std::max<int64_t>((minX - kHalf + kSubpixelOne - 1) >> kSubpixelBits, 0);
-        const int64_t bx1 = std::min<int64_t>((maxX - kHalf) >> kSubpixelBits, W - 1);
-        const int64_t by0 = std::max<int64_t>((minY - kHalf + kSubpixelOne - 1) >> kSubpixelBits, 0);
-        const int64_t by1 = std::min<int64_t>((maxY - kHalf) >> kSubpixelBits, H - 1);
-        if (bx0 > bx1 || by0 > by1) {  // no center inside the box (or box outside the viewport)
-            ++empty;
-            continue;
-        }
-        if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed) {
-            ++empty;  // outside the representable range (kMaxFixed): a clip-stage contract violation
-            continue;
-        }
-
-        // Orientation: twice the signed area; zero area draws nothing, negative is swapped so that
-        // one inside test serves both windings.
-        const int64_t area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
-        if (area == 0) {
-            ++empty;
-            continue;
-        }
-        if (area < 0) {
-            std::swap(x1, x2);
-            std::swap(y1, y2);
-        }
-        const DepthPlane plane = planes[planeIndex[t]];
-        if (!plane.valid) {
-            ++empty;
-            continue;
-        }
-        const uint32_t idValue = tris.source[t] + 1;
-
-        // Edge functions at the box's first center; edge k is the one opposite vertex k.
-        const int64_t sx = bx0 * kSubpixelOne + kHalf, sy = by0 * kSubpixelOne + kHalf;
-        const EdgeSetup e0 = setupEdge(x1, y1, x2, y2, sx, sy);
-        const EdgeSetup e1 = setupEdge(x2, y2, x0, y0, sx, sy);
-        const EdgeSetup e2 = setupEdge(x0, y0, x1, y1, sx, sy);
-
-        // One covered center: depth from the plane exactly as evalDepthPlane writes it
-        // ((a*px + b*py) + c, b*py shared by the row: the same IEEE product), then encode and test.
-        uint64_t triFragments = 0;
-        const double pa = plane.a, pb = plane.b, pc = plane.c;
-        auto shade = [&](size_t idx, double px, double bpy) {
-            const double pv = (pa * px + bpy) + pc;
-            const double d = kPerspective ? 1.0 / pv : pv;
+    void fragment(size_t idx, size_t, double d) {
+        fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
+        // LESS: on equal keys (or equal depths) the first drawn fragment stays. Written as selects,
+        // not a branch: about half the fragments pass, in no predictable pattern.
+        bool pass;
+        if constexpr (kExact) {
+            pass = d < depthBuf[idx];
+        } else {
             uint32_t key;
             bool oor = false;
             encodeDepth<F>(enc, d, key, oor);
             outOfRange += oor ? 1 : 0;
-            ++triFragments;
-            fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
-            // LESS: on equal keys the first drawn fragment stays. Written as selects, not a branch:
-            // about half the fragments pass, in no predictable pattern.
             const uint32_t oldKey = keyBuf[idx];
-            const bool pass = key < oldKey;
+            pass = key < oldKey;
             keyBuf[idx] = pass ? key : oldKey;
-            idBuf[idx] = pass ? idValue : idBuf[idx];
-            depthBuf[idx] = pass ? d : depthBuf[idx];
-            passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
-            passes += pass ? 1 : 0;
-        };
-
-        int64_t r0 = e0.value, r1 = e1.value, r2 = e2.value;
-        const int64_t boxW = bx1 - bx0 + 1, boxH = by1 - by0 + 1;
-        if (((boxW - 1) | (boxH - 1)) < 8 && maxX - minX <= kBlockExtent && maxY - minY <= kBlockExtent) {
-            // Small (most triangles of a dense mesh): one 4 x 4 or 8 x 8 block of inside tests
-            // ((w-1)|(h-1) < n <=> both sides <= n for n a power of two), then shade the set bits.
-            const int32_t r[3] = {int32_t(r0), int32_t(r1), int32_t(r2)};
-            const int32_t stepX[3] = {int32_t(e0.stepX), int32_t(e1.stepX), int32_t(e2.stepX)};
-            const int32_t stepY[3] = {int32_t(e0.stepY), int32_t(e1.stepY), int32_t(e2.stepY)};
-            const uint64_t cover = ((boxW - 1) | (boxH - 1)) < 4 ? blockCoverage<4, 4>(r, stepX, stepY)
-                                                               : blockCoverage<8, 8>(r, stepX, stepY);
-            // Bits of the block inside the box: boxW columns of each of the first boxH rows.
-            const uint64_t boxBits = ((uint64_t(1) << boxW) - 1) * (kRowStarts >> (64 - 8 * boxH));
-            uint64_t mask = cover & boxBits;
-            while (mask) {
-                const int bit = std::countr_zero(mask);
-                mask &= mask - 1;
-                const int64_t x = bx0 + (bit & 7), y = by0 + (bit >> 3);
-                shade(size_t(y) * size_t(W) + size_t(x), double(x) + 0.5, pb * (double(y) + 0.5));
-            }
-        } else if (boxW < kSpanMinWidth) {
-            // Narrow box: test every center, stepping the edge functions exactly.
-            for (int64_t y = by0; y <= by1; ++y) {
-                const double bpy = pb * (double(y) + 0.5);
-                const size_t row = size_t(y) * size_t(W);
-                int64_t c0 = r0, c1 = r1, c2 = r2;
-                for (int64_t x = bx0; x <= bx1; ++x) {
-                    if ((c0 | c1 | c2) >= 0) shade(row + size_t(x), double(x) + 0.5, bpy);
-                    c0 += e0.stepX;
-                    c1 += e1.stepX;
-                    c2 += e2.stepX;
-                }
-                r0 += e0.stepY;
-                r1 += e1.stepY;
-                r2 += e2.stepY;
-            }
-        } else {
-            // Wide box: per row, edge k covers offset j (x = bx0 + j) iff r_k + j * stepX_k >= 0:
-            //   stepX > 0: j >= ceil(-r / stepX) = -floor(r / stepX)
-            //   stepX < 0: j <= floor(r / -stepX)
-            //   stepX = 0: every j if r >= 0, none otherwise.
-            const int64_t lastJ = bx1 - bx0;
-            const EdgeSetup *edges[3] = {&e0, &e1, &e2};
-            for (int64_t y = by0; y <= by1; ++y) {
-                const int64_t r[3] = {r0, r1, r2};
-                int64_t lo = 0, hi = lastJ;
-                for (int k = 0; k < 3; ++k) {
-                    const int64_t s = edges[k]->stepX;
-                    if (s > 0) lo = std::max(lo, -floorDiv(r[k], s));
-                    else if (s < 0) hi = std::min(hi, floorDiv(r[k], -s));
-                    else if (r[k] < 0) hi = -1;
-                }
-                if (lo <= hi) {
-                    const double bpy = pb * (double(y) + 0.5);
-                    const size_t row = size_t(y) * size_t(W);
-                    for (int64_t x = bx0 + lo; x <= bx0 + hi; ++x) shade(row + size_t(x), double(x) + 0.5, bpy);
-                }
-                r0 += e0.stepY;
-                r1 += e1.stepY;
-                r2 += e2.stepY;
-            }
         }
-        fragments += triFragments;
-        if (triFragments) ++drawn;
-        else ++empty;
+        idBuf[idx] = pass ? uint32_t(idValue) : idBuf[idx];
+        depthBuf[idx] = pass ? d : depthBuf[idx];
+        passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
+        passes += pass ? 1 : 0;
     }
-    st.fragments += fragments;
-    st.depthPasses += passes;
-    st.outOfRangeFragments += outOfRange;
-    st.trianglesDrawn += drawn;
-    st.trianglesEmpty += empty;
+
+    void endTriangle(size_t t, uint64_t n) {
+        fragments += n;
+        drawn += n != 0 ? 1 : 0;
+        if (fragmentsPerSource) fragmentsPerSource[source[t]] += uint32_t(n);
+    }
+};
+
+template <DepthFormat F, bool kExact>
+void rasterizeWith(const ScreenTriangles &tris, const ZBufferSettings &settings, ZBuffer &zb, ZBufferStats &st) {
+    ZBufferSink<F, kExact> sink{settings.encoder,    tris.source.data(), settings.singleSided,
+                                settings.fragmentsPerSource, zb.key.data(), zb.id.data(),
+                                zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
+    forEachFragment(tris, zb.width, zb.height, settings.orthographic, sink);
+    st.fragments += sink.fragments;
+    st.depthPasses += sink.passes;
+    st.outOfRangeFragments += sink.outOfRange;
+    st.trianglesDrawn += sink.drawn;
+    st.trianglesEmpty += st.trianglesIn - sink.drawn;
+    st.trianglesBackWinding += sink.backWinding;
+    if constexpr (kExact) {
+        // The keys of the stored depths, so the buffer reads the same as a format-tested one.
+        for (size_t i = 0; i < zb.id.size(); ++i)
+            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
+    }
 }
 
 }  // namespace
@@ -325,11 +124,12 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
     ZBufferStats &st = r.stats;
     st.trianglesIn = tris.size();
     if (pixels > 0) {
-        const DepthEncoder &enc = settings.encoder;
-        dispatchDepthFormat(enc.format, [&]<DepthFormat F>() {
-            if (settings.orthographic) rasterizeTriangles<F, false>(tris, enc, zb, st);
-            else rasterizeTriangles<F, true>(tris, enc, zb, st);
-        });
+        if (settings.exactDepth) {
+            rasterizeWith<DepthFormat::f32, true>(tris, settings, zb, st);  // the format is not used per fragment
+        } else {
+            dispatchDepthFormat(settings.encoder.format,
+                                [&]<DepthFormat F>() { rasterizeWith<F, false>(tris, settings, zb, st); });
+        }
     } else {
         st.trianglesEmpty = tris.size();
     }

@@ -8,6 +8,7 @@
 // Depth: per covered pixel the fragment's view depth is computed in double from the triangle's
 // DepthPlane at the pixel center (viewDepthAt), encoded in the view's depth format, and tested with
 // LESS on the format's ordering key: on equal stored values the first drawn fragment wins.
+// The coverage walk itself is render/raster_core.h (forEachFragment), shared with the audits.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +39,23 @@ int32_t toFixed(double pixelCoordinate);
 struct ZBufferSettings {
     DepthEncoder encoder;       // the view's depth format bound to its near/far
     bool orthographic = false;  // how DepthPlane values turn into view depth
+
+    // Options for the audits (analysis/audit.h); the defaults are the plain z-buffer and cost
+    // nothing (exactDepth selects another instantiation; the pointers are tested once a triangle).
+    //
+    // exactDepth: the depth test compares the double view depth (LESS: on equal depths the first
+    // drawn fragment wins) instead of the format's key. `key` is then filled after the pass with
+    // the format's key of each pixel's stored depth, and outOfRangeFragments stays 0 (no fragment
+    // goes through the format).
+    bool exactDepth = false;
+    // singleSided: per *source* triangle (indexed by ScreenTriangles::source); where non-null and
+    // nonzero, the triangle is drawn only when its projected winding is the front one
+    // (counter-clockwise as the viewer sees it; raster_core.h). Others are counted in
+    // trianglesBackWinding (and among trianglesEmpty).
+    const uint8_t *singleSided = nullptr;
+    // fragmentsPerSource: optional, per source triangle: += the fragments rasterized for it (every
+    // covered center, whether it passed the depth test or not). The caller sizes and zeroes it.
+    uint32_t *fragmentsPerSource = nullptr;
 };
 
 // Per-pixel buffers, row-major, pixel (0,0) top-left.
@@ -54,6 +72,8 @@ struct ZBufferStats {
     uint64_t trianglesIn = 0;         // triangles submitted
     uint64_t trianglesDrawn = 0;      // triangles that produced at least one fragment
     uint64_t trianglesEmpty = 0;      // triangles that cover no pixel center (zero area or tiny); best 0
+    uint64_t trianglesBackWinding = 0;// single-sided (settings.singleSided) with the back winding on screen:
+                                      //   not drawn (counted among trianglesEmpty); 0 without singleSided
     uint64_t fragments = 0;           // pixel centers covered, summed over triangles
     uint64_t depthPasses = 0;         // fragments that passed the depth test and were written
     uint64_t outOfRangeFragments = 0; // fragments whose depth the format cannot represent (clamped)
