@@ -21,6 +21,7 @@
 #include "render/clip.h"
 #include "render/depth_format.h"
 #include "render/raster.h"
+#include "render/raster_core.h"
 
 namespace va {
 namespace {
@@ -771,6 +772,244 @@ TEST(RasterBenchScene, RasterizeIsConsistentAndDeterministic) {
     EXPECT_EQ(a.buffer.id, b.buffer.id);
     EXPECT_EQ(a.buffer.key, b.buffer.key);
     EXPECT_EQ(a.buffer.fragments, b.buffer.fragments);
+}
+
+// ---- The fragment core (raster_core.h) and the audit options --------------------------------
+
+// A sink recording every call, to check forEachFragment's contract against the brute force.
+struct RecordingSink {
+    int W = 0;
+    std::vector<std::vector<std::pair<size_t, double>>> frags;  // per triangle: (pixel, depth)
+    std::vector<int> begun, ended;                               // calls per triangle
+    std::vector<uint64_t> endCount;
+    size_t current = ~size_t(0);
+    bool beginTriangle(size_t t, bool) {
+        ++begun[t];
+        current = t;
+        return true;
+    }
+    void fragment(size_t pixel, size_t t, double d) {
+        EXPECT_EQ(t, current);
+        frags[t].push_back({pixel, d});
+    }
+    void endTriangle(size_t t, uint64_t n) {
+        ++ended[t];
+        endCount[t] = n;
+    }
+};
+
+// forEachFragment visits exactly the brute-force reference's covered centers, once each, with
+// the depth of viewDepthAt bit for bit, and calls begin/end once per triangle that has an area.
+TEST(RasterCore, FragmentsMatchBruteForce) {
+    const int W = 61, H = 43;
+    for (uint32_t seed = 300; seed < 306; ++seed) {
+        const bool ortho = seed % 2;
+        const ScreenTriangles tris = randomSoup(seed, W, H, 250, ortho);
+        RecordingSink sink;
+        sink.W = W;
+        sink.frags.resize(tris.size());
+        sink.begun.assign(tris.size(), 0);
+        sink.ended.assign(tris.size(), 0);
+        sink.endCount.assign(tris.size(), 0);
+        forEachFragment(tris, W, H, ortho, sink);
+        Camera cam;
+        cam.orthographic = ortho;
+        uint64_t total = 0;
+        for (size_t t = 0; t < tris.size(); ++t) {
+            const DepthPlane &p = tris.planes[tris.plane[t]];
+            std::vector<std::pair<size_t, double>> want;
+            for (int y = 0; y < H && p.valid; ++y)
+                for (int x = 0; x < W; ++x)
+                    if (refCovers(&tris.xy[6 * t], x, y))
+                        want.push_back({size_t(y) * W + x, viewDepthAt(cam, p, x + 0.5, y + 0.5)});
+            std::vector<std::pair<size_t, double>> got = sink.frags[t];
+            std::sort(got.begin(), got.end());
+            ASSERT_EQ(got.size(), want.size()) << "seed " << seed << " triangle " << t;
+            for (size_t i = 0; i < want.size(); ++i) {
+                ASSERT_EQ(got[i].first, want[i].first) << "seed " << seed << " triangle " << t;
+                ASSERT_EQ(std::memcmp(&got[i].second, &want[i].second, sizeof(double)), 0);
+            }
+            EXPECT_EQ(sink.begun[t], sink.ended[t]);
+            EXPECT_LE(sink.begun[t], 1);
+            if (!want.empty()) EXPECT_EQ(sink.begun[t], 1);
+            EXPECT_EQ(sink.endCount[t], want.size());
+            total += want.size();
+        }
+        EXPECT_GT(total, 1000u);
+    }
+}
+
+// beginTriangle returning false skips the triangle: no fragment, no endTriangle.
+TEST(RasterCore, BeginFalseSkips) {
+    struct Sink {
+        uint64_t frags = 0, ends = 0;
+        bool beginTriangle(size_t t, bool) { return t % 2 == 0; }
+        void fragment(size_t, size_t t, double) { EXPECT_EQ(t % 2, 0u); ++frags; }
+        void endTriangle(size_t t, uint64_t) { EXPECT_EQ(t % 2, 0u); ++ends; }
+    } sink;
+    Builder b;
+    const uint32_t p = b.addPlane(0, 0, 0.5);
+    // Centers with x + y < 3 (the hypotenuse x + y = 3 is a bottom-right edge): 6 each.
+    for (int i = 0; i < 4; ++i) b.add(0, 0, 4 * kOne, 0, 0, 4 * kOne, p);
+    forEachFragment(b.tris, 8, 8, false, sink);
+    EXPECT_EQ(sink.frags, 12u);
+    EXPECT_EQ(sink.ends, 2u);
+}
+
+// A world triangle through the clip stage; returns its screen triangles.
+ScreenTriangles clipOne(const Camera &cam, const std::vector<Vec3> &pos, const std::vector<uint32_t> &idx) {
+    std::vector<uint32_t> tri(idx.size() / 3);
+    for (uint32_t t = 0; t < tri.size(); ++t) tri[t] = t;
+    const std::vector<ClipBatch> batches = {{0, uint32_t(pos.size()), tri.data(), uint32_t(tri.size())}};
+    return clipTriangles(cam, {pos.data(), idx.data()}, batches, {}).out;
+}
+
+// The front winding on screen: a triangle counter-clockwise seen from its front is front-wound
+// (negative signed area in y-down pixels) from the front and back-wound from behind, for
+// perspective and orthographic views and for a triangle cut by the near plane (its clipped
+// pieces keep the winding); singleSided draws exactly the front-wound ones.
+TEST(RasterWinding, FrontWindingPerspectiveOrthoAndNearClipped) {
+    // In the plane z = 0, counter-clockwise seen from +z (normal (v1-v0) x (v2-v0) = +z).
+    const std::vector<Vec3> pos = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+    const std::vector<uint32_t> idx = {0, 1, 2};
+    for (bool ortho : {false, true})
+        for (double side : {1.0, -1.0}) {
+            CameraSpec spec;
+            spec.eye = {0.1, 0.2, 4 * side};
+            spec.target = {0, 0, 0};
+            spec.orthographic = ortho;
+            spec.orthoHeight = 4;
+            spec.width = 40;
+            spec.height = 30;
+            spec.nearZ = 0.5;
+            spec.farZ = 100;
+            Camera cam;
+            std::string err;
+            ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+            const ScreenTriangles st = clipOne(cam, pos, idx);
+            ASSERT_EQ(st.size(), 1u);
+            const int32_t *v = st.xy.data();
+            const int64_t area = int64_t(v[2] - v[0]) * (v[5] - v[1]) - int64_t(v[3] - v[1]) * (v[4] - v[0]);
+            EXPECT_EQ(area < 0, side > 0) << (ortho ? "ortho" : "persp") << " side " << side;
+
+            struct Sink {
+                std::vector<int> front;
+                bool beginTriangle(size_t, bool f) { front.push_back(f); return true; }
+                void fragment(size_t, size_t, double) {}
+                void endTriangle(size_t, uint64_t) {}
+            } sink;
+            forEachFragment(st, cam.width, cam.height, ortho, sink);
+            ASSERT_EQ(sink.front.size(), 1u);
+            EXPECT_EQ(sink.front[0] != 0, side > 0);
+
+            const uint8_t single[1] = {1}, dbl[1] = {0};
+            ZBufferSettings s = settingsFor(DepthFormat::f32, ortho, cam.nearZ, cam.farZ);
+            s.singleSided = single;
+            const ZBufferResult z1 = rasterize(st, cam.width, cam.height, s);
+            s.singleSided = dbl;
+            const ZBufferResult z2 = rasterize(st, cam.width, cam.height, s);
+            EXPECT_GT(z2.stats.fragments, 50u);
+            EXPECT_EQ(z1.stats.fragments, side > 0 ? z2.stats.fragments : 0u);
+            EXPECT_EQ(z1.stats.trianglesBackWinding, side > 0 ? 0u : 1u);
+            EXPECT_EQ(z1.stats.trianglesDrawn + z1.stats.trianglesEmpty, z1.stats.trianglesIn);
+        }
+    // Cut by the near plane (perspective): a large floor triangle under the eye, seen from above
+    // (front) and from below (back). Every clipped piece has the same winding as the source.
+    const std::vector<Vec3> floorPos = {{-50, -1, 50}, {50, -1, 50}, {0, -1, -50}};  // CCW from +y
+    for (double up : {1.0, -1.0}) {
+        CameraSpec spec;
+        spec.eye = {0, -1 + up, 0};
+        spec.target = {0, -1 + 0.5 * up, -3};
+        spec.width = 64;
+        spec.height = 48;
+        spec.nearZ = 0.5;
+        spec.farZ = 30;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+        const ScreenTriangles st = clipOne(cam, floorPos, idx);
+        ASSERT_GE(st.size(), 2u);  // clipped into a polygon with 4+ vertices
+        for (size_t t = 0; t < st.size(); ++t) {
+            const int32_t *v = &st.xy[6 * t];
+            const int64_t area = int64_t(v[2] - v[0]) * (v[5] - v[1]) - int64_t(v[3] - v[1]) * (v[4] - v[0]);
+            EXPECT_EQ(area < 0, up > 0) << "piece " << t << " up " << up;
+        }
+    }
+}
+
+// exactDepth: the double depth decides where a format's keys tie; equal doubles keep the first
+// drawn; the key buffer holds the format's key of the stored depth.
+TEST(RasterOptions, ExactDepth) {
+    const int W = 16, H = 16;
+    ZBufferSettings s16 = settingsFor(DepthFormat::unorm16, false, 0.5, 200);
+    ASSERT_EQ(depthKey(s16.encoder, 199.9), depthKey(s16.encoder, 199.8));
+    s16.exactDepth = true;
+    // B (farther, drawn first) loses the overlap to A in exact depth, unlike the format test.
+    const ZBufferResult z = rasterize(twoRects(false, 199.8, 199.9).tris, W, H, s16);
+    EXPECT_EQ(z.buffer.id[5 * W + 5], 11u);
+    EXPECT_EQ(z.buffer.depth[5 * W + 5], 1 / (1 / 199.8));
+    EXPECT_EQ(z.buffer.key[5 * W + 5], depthKey(s16.encoder, 1 / (1 / 199.8)));
+    EXPECT_EQ(z.buffer.key[14 * W + 14], 0xFFFFFFFFu);
+    EXPECT_EQ(z.stats.depthPasses, 128u);
+    EXPECT_EQ(z.stats.outOfRangeFragments, 0u);
+    for (bool order : {true, false}) {
+        ZBufferSettings s = settingsFor(DepthFormat::f32, false);
+        s.exactDepth = true;
+        const ZBufferResult e = rasterize(twoRects(order, 3, 3).tris, W, H, s);
+        EXPECT_EQ(e.buffer.id[5 * W + 5], order ? 11u : 21u);
+        EXPECT_EQ(e.stats.depthPasses, 112u);
+    }
+    // On random soups, exact depth equals the brute force with the key replaced by the depth.
+    for (uint32_t seed = 400; seed < 404; ++seed) {
+        const bool ortho = seed % 2;
+        const ScreenTriangles tris = randomSoup(seed, 50, 40, 200, ortho);
+        ZBufferSettings s = settingsFor(DepthFormat::inv_f32, ortho);
+        s.exactDepth = true;
+        const ZBufferResult got = rasterize(tris, 50, 40, s);
+        // Reference: a double z-buffer (LESS, first drawn wins) over the brute-force coverage.
+        std::vector<double> depth(50 * 40, INFINITY);
+        std::vector<uint32_t> id(50 * 40, 0);
+        Camera cam;
+        cam.orthographic = ortho;
+        for (size_t t = 0; t < tris.size(); ++t) {
+            const DepthPlane &p = tris.planes[tris.plane[t]];
+            for (int y = 0; y < 40 && p.valid; ++y)
+                for (int x = 0; x < 50; ++x)
+                    if (refCovers(&tris.xy[6 * t], x, y)) {
+                        const double d = viewDepthAt(cam, p, x + 0.5, y + 0.5);
+                        if (d < depth[size_t(y) * 50 + x]) {
+                            depth[size_t(y) * 50 + x] = d;
+                            id[size_t(y) * 50 + x] = tris.source[t] + 1;
+                        }
+                    }
+        }
+        EXPECT_EQ(got.buffer.id, id) << "seed " << seed;
+        for (size_t i = 0; i < depth.size(); ++i) ASSERT_EQ(std::memcmp(&got.buffer.depth[i], &depth[i], 8), 0);
+    }
+}
+
+// fragmentsPerSource: per source triangle, the fragments of all its pieces; the default path's
+// buffers are unchanged by the counter.
+TEST(RasterOptions, FragmentsPerSource) {
+    const int W = 53, H = 37;
+    const ScreenTriangles tris = randomSoup(77, W, H, 200, false);
+    const uint32_t maxSource = *std::max_element(tris.source.begin(), tris.source.end());
+    std::vector<uint32_t> per(maxSource + 1, 0);
+    ZBufferSettings s = settingsFor(DepthFormat::f32, false);
+    const ZBufferResult plain = rasterize(tris, W, H, s);
+    s.fragmentsPerSource = per.data();
+    const ZBufferResult counted = rasterize(tris, W, H, s);
+    expectSameBuffers(counted, plain, "with fragmentsPerSource");
+    std::vector<uint32_t> want(maxSource + 1, 0);
+    for (size_t t = 0; t < tris.size(); ++t) {
+        if (!tris.planes[tris.plane[t]].valid) continue;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) want[tris.source[t]] += refCovers(&tris.xy[6 * t], x, y);
+    }
+    EXPECT_EQ(per, want);
+    uint64_t sum = 0;
+    for (uint32_t c : per) sum += c;
+    EXPECT_EQ(sum, plain.stats.fragments);
 }
 
 }  // namespace
