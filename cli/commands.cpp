@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <functional>
 #include <sstream>
 #include <mutex>
 #include <string>
@@ -24,6 +26,7 @@
 #include "reports/console.h"
 #include "reports/depth_audit_report.h"
 #include "reports/depth_plot.h"
+#include "reports/budget.h"
 #include "reports/merge.h"
 #include "reports/report.h"
 
@@ -48,6 +51,8 @@ struct Options {
     std::string auditOut; // empty = console only
     std::string shard;    // analyze --shard K/N
     std::vector<std::string> mergeDirs;
+    // check
+    std::string budget, baseline, junit;
 };
 
 void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
@@ -139,7 +144,12 @@ int cmdInfo(const Options &o) {
     return kExitOk;
 }
 
-int cmdAnalyze(const Options &o) {
+// Runs `analyze` as the options say and writes the report folder. `beforeRun` (optional) sees the
+// views after loading and may refuse them (check validates its budget there, before any work);
+// `report` receives the report JSON. Returns an exit code.
+int analyzeToReport(const Options &o,
+                    const std::function<bool(const std::vector<ViewSpec> &, std::string *)> &beforeRun,
+                    nlohmann::ordered_json *report) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     PipelineSettings settings;
@@ -173,6 +183,10 @@ int cmdAnalyze(const Options &o) {
         bases.push_back(allBases[i]);
     }
     views = std::move(selected);
+    if (beforeRun && !beforeRun(views, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
 
     OutputDir out;
     if (!out.open(o.out, &err)) {
@@ -201,9 +215,10 @@ int cmdAnalyze(const Options &o) {
     }
     if (tty && !o.quiet) std::fprintf(stderr, "\n");
     result.loadMs = loadMs;
+    *report = reportJson(result);
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was.
-    if (!writeFileAtomic(out.staging() + "/report.json", reportJson(result).dump(2) + "\n", &err) ||
+    if (!writeFileAtomic(out.staging() + "/report.json", report->dump(2) + "\n", &err) ||
         !out.commit(&err)) {
         fail(err);
         return kExitBadInput;
@@ -214,6 +229,61 @@ int cmdAnalyze(const Options &o) {
         std::printf("report: %s/report.json\n", o.out.c_str());
     }
     return kExitOk;
+}
+
+int cmdAnalyze(const Options &o) {
+    nlohmann::ordered_json report;
+    return analyzeToReport(o, nullptr, &report);
+}
+
+int cmdCheck(const Options &o) {
+    Budget budget;
+    nlohmann::ordered_json baseline;
+    std::string err;
+    if (!o.baseline.empty()) {
+        std::ifstream f(o.baseline, std::ios::binary);
+        std::stringstream ss;
+        ss << f.rdbuf();
+        if (!f) {
+            fail("--baseline " + o.baseline + ": cannot be read; give the report.json of an earlier analyze run");
+            return kExitBadInput;
+        }
+        try {
+            baseline = nlohmann::ordered_json::parse(ss.str());
+        } catch (const std::exception &e) {
+            fail("--baseline " + o.baseline + ": not valid JSON (" + e.what() + ")");
+            return kExitBadInput;
+        }
+    }
+    // The budget is validated against the views before anything is analysed.
+    auto validate = [&](const std::vector<ViewSpec> &views, std::string *e) {
+        std::vector<std::string> names;
+        for (const ViewSpec &v : views) names.push_back(v.name);
+        return loadBudget(o.budget, names, &budget, e);
+    };
+    nlohmann::ordered_json report;
+    const int code = analyzeToReport(o, validate, &report);
+    if (code != kExitOk) return code;
+    BudgetResult result;
+    if (!evaluateBudget(budget, report, o.baseline.empty() ? nullptr : &baseline, &result, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    std::printf("%s", budgetTable(result).c_str());
+    if (!o.junit.empty() && !writeFileAtomic(o.junit, budgetJUnit(result, report["scene"]["path"]), &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    return result.failed ? kExitBudgetFailed : kExitOk;
+}
+
+void addAnalyzeOptions(CLI::App *c, Options &o);
+
+void addCheckOptions(CLI::App *c, Options &o) {
+    addAnalyzeOptions(c, o);
+    c->add_option("--budget", o.budget, "Budget file (visaudit-budget/1): limits per scene and per view")->required();
+    c->add_option("--baseline", o.baseline, "An earlier report.json: fail on relative regressions the budget forbids");
+    c->add_option("--junit", o.junit, "Write JUnit XML here: one test case per view and budget");
 }
 
 int cmdMerge(const Options &o) {
@@ -333,6 +403,8 @@ const Command kCommands[] = {
      cmdInfo},
     {"analyze", "Run every stage for every view; write report.json and images to --out", addAnalyzeOptions,
      cmdAnalyze},
+    {"check", "Analyze, then fail (exit 1) when a view exceeds its budget or regresses against a baseline",
+     addCheckOptions, cmdCheck},
     {"merge", "Join the reports of analyze --shard K/N runs into one report", addMergeOptions, cmdMerge},
     {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
      addDepthAuditOptions, cmdDepthAudit},

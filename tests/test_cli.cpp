@@ -284,3 +284,82 @@ TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
     EXPECT_NE(bad.err.find("shards overlap"), std::string::npos) << bad.err;
     EXPECT_FALSE(fs::exists(dir_ / "bad"));
 }
+
+TEST_F(CliTest, CheckPassesALooseBudgetAndFailsATightOneWithJUnit) {
+    const fs::path loose = dir_ / "loose.json", tight = dir_ / "tight.json";
+    std::ofstream(loose) << R"({"format": "visaudit-budget/1", "limits": {"overdraw": 3, "zbuffer_triangles": 1000000}})";
+    std::ofstream(tight) << R"({"format": "visaudit-budget/1", "limits": {"overdraw": 3},
+                               "views": {"spawn": {"zbuffer_triangles": 100}}})";
+    RunResult r = run("check --budget " + loose.string() + " --quiet --out " + (dir_ / "a").string() + " --junit " +
+                      (dir_ / "a.xml").string());
+    EXPECT_EQ(r.code, 0) << r.err << r.out;
+    EXPECT_NE(r.out.find("4 passed, 0 failed"), std::string::npos) << r.out;
+    r = run("check --budget " + tight.string() + " --quiet --out " + (dir_ / "b").string() + " --junit " +
+            (dir_ / "b.xml").string());
+    EXPECT_EQ(r.code, 1) << r.err << r.out;
+    const auto report = nlohmann::json::parse(slurp(dir_ / "b" / "report.json"));
+    const uint64_t drawn = report["views"][0]["stages"][4]["triangles_out"];
+    ASSERT_EQ(report["views"][0]["stages"][4]["name"], "zbuffer");
+    EXPECT_NE(r.out.find("FAIL: zbuffer_triangles in view 'spawn' is " + std::to_string(drawn) + ", allowed 100"),
+              std::string::npos)
+        << r.out;
+    const std::string xml = slurp(dir_ / "b.xml");
+    EXPECT_NE(xml.find("<testsuites name=\"visaudit check\" tests=\"3\" failures=\"1\">"), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<failure message=\"zbuffer_triangles in view &apos;spawn&apos; is"), std::string::npos) << xml;
+    // Well-formed: every opened testcase with a failure is closed; the document closes.
+    EXPECT_EQ(xml.substr(xml.size() - 14), "</testsuites>\n");
+}
+
+TEST_F(CliTest, CheckRegressionsAgainstABaseline) {
+    const fs::path budget = dir_ / "budget.json";
+    std::ofstream(budget) << R"({"format": "visaudit-budget/1", "regressions": {"zbuffer_triangles": 0.1}})";
+    ASSERT_EQ(run("analyze --quiet --out " + (dir_ / "base").string()).code, 0);
+    // Without backface culling the z-buffer draws far more triangles: a regression.
+    const RunResult r = run("check --budget " + budget.string() + " --baseline " +
+                            (dir_ / "base" / "report.json").string() + " --no-backface --quiet --out " +
+                            (dir_ / "new").string());
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.out.find("zbuffer_triangles in view 'spawn' rose "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(", allowed 10%"), std::string::npos) << r.out;
+    // The same settings: no regression.
+    EXPECT_EQ(run("check --budget " + budget.string() + " --baseline " + (dir_ / "base" / "report.json").string() +
+                  " --quiet --out " + (dir_ / "same").string())
+                  .code,
+              0);
+}
+
+TEST_F(CliTest, CheckRefusesBadBudgetsAndBaselinesBeforeAnalysing) {
+    struct Case {
+        std::string budget, message;
+    };
+    const std::vector<Case> cases = {
+        {R"({"format": "visaudit-budget/1", "limits": {"overdrew": 2}})",
+         ":1:44: limits: unknown metric 'overdrew', did you mean 'overdraw'?"},
+        {R"({"format": "visaudit-budget/1", "views": {"spwan": {}}})",
+         "views: no view named 'spwan', did you mean 'spawn'? (views: spawn, overview)"},
+        {R"({"format": "visaudit-budget/1", "limits": {"min_depth_format": "f16"}})",
+         "limits.min_depth_format: unknown depth format 'f16'"},
+        {R"({"format": "visaudit-budget/1", "limits": {"overdraw": "low"}})",
+         "limits.overdraw: expected a number >= 0, got a string"},
+        {R"({"format": "visaudit-budget/2"})", "\"format\" must be \"visaudit-budget/1\""},
+    };
+    for (const Case &c : cases) {
+        const fs::path b = dir_ / "b.json";
+        std::ofstream(b) << c.budget;
+        const RunResult r = run("check --budget " + b.string() + " --quiet --out " + (dir_ / "out").string());
+        EXPECT_EQ(r.code, 2) << c.budget;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.budget << "\n" << r.err;
+        EXPECT_FALSE(fs::exists(dir_ / "out")) << "nothing is analysed or written for a bad budget";
+    }
+    // A baseline of another scene.
+    const fs::path b = dir_ / "ok.json";
+    std::ofstream(b) << R"({"format": "visaudit-budget/1", "regressions": {"overdraw": 0.1}})";
+    ASSERT_EQ(run("analyze " + kExamples + "/hall.scene.json --quiet --width 64 --height 36 --out " +
+                  (dir_ / "hall").string())
+                  .code,
+              0);
+    const RunResult r = run("check --budget " + b.string() + " --baseline " + (dir_ / "hall" / "report.json").string() +
+                            " --quiet --out " + (dir_ / "demo").string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("the baseline is a report of another scene"), std::string::npos) << r.err;
+}

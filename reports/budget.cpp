@@ -1,0 +1,361 @@
+#include "reports/budget.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "analysis/json_util.h"
+#include "render/depth_format.h"
+
+namespace va {
+
+using OJson = nlohmann::ordered_json;
+
+const std::vector<BudgetMetric> &budgetMetrics() {
+    static const std::vector<BudgetMetric> m = {
+        {"zbuffer_triangles", "triangles the z-buffer drew (after every culling stage)", false, true},
+        {"overdraw", "depth-test passes / covered pixels", false, true},
+        {"depth_complexity", "fragments / covered pixels", false, true},
+        {"zfight_pixels", "pixels that z-fight in the view's depth format", false, true},
+        {"zfight_hotspots", "z-fighting hotspots in the view's depth format", false, true},
+        {"false_culls", "triangles culled by a stage yet visible in the reference (default limit 0)", false, true},
+        {"wasted_draw_share", "share of drawn triangles visible nowhere (0..1)", false, true},
+        {"min_depth_format", "the cheapest depth format the view must not z-fight in", true, false},
+    };
+    return m;
+}
+
+namespace {
+
+std::vector<std::string> metricNames(bool numericOnly) {
+    std::vector<std::string> v;
+    for (const BudgetMetric &m : budgetMetrics())
+        if (!numericOnly || !m.isFormat) v.push_back(m.name);
+    return v;
+}
+
+const BudgetMetric *findMetric(const std::string &name) {
+    for (const BudgetMetric &m : budgetMetrics())
+        if (name == m.name) return &m;
+    return nullptr;
+}
+
+std::string fmt(double v) {
+    char b[64];
+    if (v == std::floor(v) && std::fabs(v) < 1e15)
+        std::snprintf(b, sizeof b, "%.0f", v);
+    else
+        std::snprintf(b, sizeof b, "%.4g", v);
+    return b;
+}
+
+// Validates one "metric: limit" object at path p.
+bool readLimits(const json::Doc &doc, const json::Path &p, const json::Json &obj,
+                std::map<std::string, nlohmann::json> *out, std::string *err) {
+    if (!obj.is_object()) {
+        *err = json::where(doc, p) + ": " + json::pathString(p) + ": expected an object of limits, got " +
+               json::typeName(obj);
+        return false;
+    }
+    for (const auto &[key, value] : obj.items()) {
+        const BudgetMetric *m = findMetric(key);
+        if (!m) {
+            const std::string near = json::closest(key, metricNames(false));
+            *err = json::where(doc, p / key, true) + ": " + json::pathString(p) + ": unknown metric '" + key + "'" +
+                   (near.empty() ? "" : ", did you mean '" + near + "'?") +
+                   " (known: " + json::joinList(metricNames(false)) + ")";
+            return false;
+        }
+        if (m->isFormat) {
+            DepthFormat f;
+            std::string e;
+            if (!value.is_string() || !parseDepthFormat(value.get<std::string>(), &f, &e)) {
+                *err = json::where(doc, p / key) + ": " + json::pathString(p / key) + ": " +
+                       (value.is_string() ? e : "expected a depth format name, got " + json::typeName(value));
+                return false;
+            }
+        } else if (!value.is_number() || !(value.get<double>() >= 0)) {
+            *err = json::where(doc, p / key) + ": " + json::pathString(p / key) +
+                   ": expected a number >= 0, got " + json::typeName(value);
+            return false;
+        }
+        (*out)[key] = value;
+    }
+    return true;
+}
+
+// The value of a numeric metric in one view of a report; nullopt when the report has no such data.
+std::optional<double> metricValue(const std::string &metric, const OJson &view) {
+    auto at = [&](std::initializer_list<const char *> path) -> const OJson * {
+        const OJson *x = &view;
+        for (const char *k : path) {
+            if (!x->is_object() || !x->contains(k)) return nullptr;
+            x = &(*x)[k];
+        }
+        return x;
+    };
+    if (metric == "zbuffer_triangles") {
+        for (const OJson &s : view["stages"])
+            if (s["name"] == "zbuffer" && s["ran"] == true) return s["triangles_out"].get<double>();
+        return std::nullopt;
+    }
+    const OJson *x = nullptr;
+    if (metric == "overdraw") x = at({"zbuffer", "overdraw"});
+    if (metric == "depth_complexity") x = at({"zbuffer", "depth_complexity"});
+    if (metric == "false_culls") x = at({"audit", "false_culls", "triangles"});
+    if (metric == "wasted_draw_share") x = at({"audit", "wasted_draws", "share"});
+    if (metric == "zfight_pixels" || metric == "zfight_hotspots") {
+        const OJson *formats = at({"depth", "formats"});
+        const std::string f = view["depth_format"];
+        if (formats && formats->contains(f))
+            x = &(*formats)[f][metric == "zfight_pixels" ? "fighting_pixels" : "hotspots"];
+    }
+    if (!x) return std::nullopt;
+    if (x->is_null()) return 0.0;  // JSON null for a non-finite ratio (nothing covered): no load
+    return x->get<double>();
+}
+
+const char *sectionFor(const std::string &metric) {
+    if (metric == "false_culls" || metric == "wasted_draw_share") return "the reference-visibility audit";
+    if (metric == "zfight_pixels" || metric == "zfight_hotspots" || metric == "min_depth_format")
+        return "the z-fighting analysis";
+    return "the z-buffer stage";
+}
+
+}  // namespace
+
+bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err) {
+    json::Doc doc;
+    if (!json::parseFile(path, &doc, err)) return false;
+    const json::Json &root = doc.root;
+    const json::Path top;
+    if (!root.is_object()) {
+        *err = path + ": expected a JSON object {\"format\": \"" + kBudgetFormat + "\", \"limits\": {...}}";
+        return false;
+    }
+    if (!root.contains("format") || root["format"] != kBudgetFormat) {
+        *err = json::where(doc, top / "format") + ": \"format\" must be \"" + kBudgetFormat + "\"";
+        return false;
+    }
+    Budget b;
+    b.file = path;
+    for (const auto &[key, value] : root.items()) {
+        if (key == "format") continue;
+        if (key == "limits") {
+            if (!readLimits(doc, top / key, value, &b.limits, err)) return false;
+        } else if (key == "views") {
+            if (!value.is_object()) {
+                *err = json::where(doc, top / key) + ": views: expected an object {\"VIEW\": {limits}}";
+                return false;
+            }
+            for (const auto &[view, limits] : value.items()) {
+                if (std::find(viewNames.begin(), viewNames.end(), view) == viewNames.end()) {
+                    const std::string near = json::closest(view, viewNames);
+                    *err = json::where(doc, top / "views" / view, true) + ": views: no view named '" + view + "'" +
+                           (near.empty() ? "" : ", did you mean '" + near + "'?") +
+                           " (views: " + json::joinList(viewNames) + ")";
+                    return false;
+                }
+                if (!readLimits(doc, top / "views" / view, limits, &b.views[view], err)) return false;
+            }
+        } else if (key == "regressions") {
+            if (!value.is_object()) {
+                *err = json::where(doc, top / key) + ": regressions: expected an object {\"metric\": allowed rise}";
+                return false;
+            }
+            for (const auto &[metric, rise] : value.items()) {
+                const BudgetMetric *m = findMetric(metric);
+                if (!m || m->isFormat) {
+                    const std::string near = json::closest(metric, metricNames(true));
+                    *err = json::where(doc, top / "regressions" / metric, true) + ": regressions: unknown metric '" +
+                           metric + "'" + (near.empty() ? "" : ", did you mean '" + near + "'?") +
+                           " (known: " + json::joinList(metricNames(true)) + ")";
+                    return false;
+                }
+                if (!rise.is_number() || !(rise.get<double>() >= 0)) {
+                    *err = json::where(doc, top / "regressions" / metric) + ": regressions." + metric +
+                           ": expected the allowed relative rise as a number >= 0 (0.1 = 10%)";
+                    return false;
+                }
+                b.regressions[metric] = rise.get<double>();
+            }
+        } else {
+            const std::string near = json::closest(key, {"format", "limits", "views", "regressions"});
+            *err = json::where(doc, top / key, true) + ": unknown key '" + key + "'" +
+                   (near.empty() ? "" : ", did you mean '" + near + "'?") +
+                   " (known: format, limits, views, regressions)";
+            return false;
+        }
+    }
+    *out = std::move(b);
+    return true;
+}
+
+bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *baseline, BudgetResult *out,
+                    std::string *err) {
+    BudgetResult r;
+    if (baseline) {
+        if (!baseline->contains("format") || (*baseline)["format"] != report["format"]) {
+            *err = "the baseline is not a " + report["format"].get<std::string>() +
+                   " report; make a new baseline with this visaudit version";
+            return false;
+        }
+        if ((*baseline)["scene"]["path"] != report["scene"]["path"] ||
+            (*baseline)["scene"]["source_triangles"] != report["scene"]["source_triangles"]) {
+            *err = "the baseline is a report of another scene (" + (*baseline)["scene"]["path"].get<std::string>() +
+                   ", " + std::to_string((*baseline)["scene"]["source_triangles"].get<uint64_t>()) +
+                   " triangles); give the baseline of " + report["scene"]["path"].get<std::string>();
+            return false;
+        }
+    }
+    for (const OJson &view : report["views"]) {
+        const std::string name = view["name"];
+        // Limits: the scene-wide ones, overridden per view; false_culls defaults to 0 where the
+        // report has the audit.
+        std::map<std::string, nlohmann::json> limits = budget.limits;
+        if (auto it = budget.views.find(name); it != budget.views.end())
+            for (const auto &[k, v] : it->second) limits[k] = v;
+        if (!limits.count("false_culls") && metricValue("false_culls", view)) limits["false_culls"] = 0;
+
+        for (const BudgetMetric &m : budgetMetrics()) {
+            auto lim = limits.find(m.name);
+            if (lim == limits.end()) continue;
+            BudgetCheck c;
+            c.view = name;
+            c.metric = m.name;
+            c.kind = "limit";
+            if (m.isFormat) {
+                // The view must fight nowhere in the named format.
+                const std::string f = lim->second.get<std::string>();
+                const OJson *formats = view.contains("depth") ? &view["depth"]["formats"] : nullptr;
+                if (!formats || !formats->contains(f)) {
+                    *err = budget.file + ": min_depth_format needs " + std::string(sectionFor(m.name)) +
+                           ", which the report of view '" + name + "' does not have";
+                    return false;
+                }
+                const double px = (*formats)[f]["fighting_pixels"].get<double>();
+                c.value = fmt(px) + " fighting pixels in " + f;
+                c.allowed = "0 in " + f;
+                c.pass = px == 0;
+                if (!c.pass)
+                    c.message = "view '" + name + "' z-fights in " + f + " at " + fmt(px) + " pixels; it needs " +
+                                (view["depth"]["recommended_format"].is_string()
+                                     ? "at least " + view["depth"]["recommended_format"].get<std::string>()
+                                     : std::string("a depth bias (it fights in every format)"));
+            } else {
+                const std::optional<double> v = metricValue(m.name, view);
+                if (!v) {
+                    *err = budget.file + ": '" + m.name + "' needs " + sectionFor(m.name) +
+                           ", which the report of view '" + name + "' does not have (did that stage run?)";
+                    return false;
+                }
+                const double limit = lim->second.get<double>();
+                c.value = fmt(*v);
+                c.allowed = "<= " + fmt(limit);
+                c.pass = *v <= limit;
+                if (!c.pass)
+                    c.message = std::string(m.name) + " in view '" + name + "' is " + fmt(*v) + ", allowed " +
+                                fmt(limit) + " (" + m.meaning + ")";
+            }
+            r.checks.push_back(c);
+        }
+        // Regressions against the baseline's view of the same name.
+        if (!baseline) continue;
+        const OJson *old = nullptr;
+        for (const OJson &bv : (*baseline)["views"])
+            if (bv["name"] == name) old = &bv;
+        for (const auto &[metric, rise] : budget.regressions) {
+            BudgetCheck c;
+            c.view = name;
+            c.metric = metric;
+            c.kind = "regression";
+            c.allowed = "+" + fmt(rise * 100) + "%";
+            const std::optional<double> now = metricValue(metric, view);
+            const std::optional<double> before = old ? metricValue(metric, *old) : std::nullopt;
+            if (!now) {
+                *err = budget.file + ": regressions." + metric + " needs " + sectionFor(metric) +
+                       ", which the report of view '" + name + "' does not have";
+                return false;
+            }
+            if (!before) {
+                c.value = fmt(*now) + " (no baseline)";
+                c.pass = true;
+            } else {
+                // Relative rise; from a baseline of 0, any rise is infinite.
+                const double rel = *before > 0 ? (*now - *before) / *before : (*now > 0 ? INFINITY : 0);
+                c.value = fmt(*before) + " -> " + fmt(*now);
+                c.pass = rel <= rise;
+                if (!c.pass) {
+                    char pct[32];
+                    std::snprintf(pct, sizeof pct, "%.0f%%", rel * 100);
+                    c.message = metric + " in view '" + name + "' rose " +
+                                (std::isfinite(rel) ? std::string(pct) : "from 0 to " + fmt(*now)) + ", allowed " +
+                                fmt(rise * 100) + "%";
+                }
+            }
+            r.checks.push_back(c);
+        }
+    }
+    for (const BudgetCheck &c : r.checks) r.failed += !c.pass;
+    *out = std::move(r);
+    return true;
+}
+
+std::string budgetTable(const BudgetResult &r) {
+    std::ostringstream s;
+    char line[512];
+    std::snprintf(line, sizeof line, "%-6s %-20s %-20s %-11s %-24s %s\n", "status", "view", "metric", "kind", "value",
+                  "allowed");
+    s << line;
+    for (int pass = 0; pass < 2; ++pass)
+        for (const BudgetCheck &c : r.checks) {
+            if (c.pass != bool(pass)) continue;
+            std::snprintf(line, sizeof line, "%-6s %-20s %-20s %-11s %-24s %s\n", c.pass ? "ok" : "FAIL",
+                          c.view.c_str(), c.metric.c_str(), c.kind.c_str(), c.value.c_str(), c.allowed.c_str());
+            s << line;
+        }
+    for (const BudgetCheck &c : r.checks)
+        if (!c.pass) s << "FAIL: " << c.message << "\n";
+    s << r.checks.size() - r.failed << " passed, " << r.failed << " failed\n";
+    return s.str();
+}
+
+namespace {
+std::string xmlEscape(const std::string &t) {
+    std::string o;
+    for (char c : t) {
+        switch (c) {
+        case '&': o += "&amp;"; break;
+        case '<': o += "&lt;"; break;
+        case '>': o += "&gt;"; break;
+        case '"': o += "&quot;"; break;
+        case '\'': o += "&apos;"; break;
+        default: o += c;
+        }
+    }
+    return o;
+}
+}  // namespace
+
+std::string budgetJUnit(const BudgetResult &r, const std::string &suite) {
+    std::ostringstream s;
+    s << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    s << "<testsuites name=\"visaudit check\" tests=\"" << r.checks.size() << "\" failures=\"" << r.failed << "\">\n";
+    s << "  <testsuite name=\"" << xmlEscape(suite) << "\" tests=\"" << r.checks.size() << "\" failures=\""
+      << r.failed << "\" errors=\"0\" skipped=\"0\">\n";
+    for (const BudgetCheck &c : r.checks) {
+        s << "    <testcase classname=\"" << xmlEscape(suite + "." + c.view) << "\" name=\""
+          << xmlEscape(c.kind + " " + c.metric) << "\"";
+        if (c.pass) {
+            s << "/>\n";
+        } else {
+            s << ">\n      <failure message=\"" << xmlEscape(c.message) << "\" type=\"budget\">"
+              << xmlEscape("value " + c.value + ", allowed " + c.allowed) << "</failure>\n    </testcase>\n";
+        }
+    }
+    s << "  </testsuite>\n</testsuites>\n";
+    return s.str();
+}
+
+}  // namespace va
