@@ -1,0 +1,194 @@
+// NAME.zfight.png (zfight_image.h). Layers, bottom to top:
+//   1. the view: depthGray (reports/report.h, the depth PNG's log scale) of the z-buffer's visible
+//      depth, halved so that colors stand out; background black;
+//   2. shared-edge and intersection pixels in their neutral marker colors;
+//   3. every hotspot's bounding box grown by two pixels, outlined in its color (largest first, so
+//      the smaller ones' outlines stay on top), with its id above the box (below when no room);
+//   4. the hotspot pixels, filled with their hotspot's color;
+//   5. the legend strip below the view.
+// Written through OpenImageIO with the same temporary-name-then-rename protocol as
+// reports/images.cpp (whose writer is file-local; this file keeps its own copy, as depth_plot.cpp).
+#include "reports/zfight_image.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include <OpenImageIO/imageio.h>
+
+#include "reports/font.h"
+
+namespace va {
+
+namespace {
+
+constexpr Rgb8 kPalette[12] = {
+    {255, 64, 64},  {64, 220, 64},  {64, 128, 255}, {255, 220, 0},  {255, 64, 255}, {0, 230, 230},
+    {255, 140, 0},  {170, 255, 0},  {255, 140, 190}, {160, 100, 255}, {0, 160, 140}, {200, 160, 0},
+};
+constexpr Rgb8 kLegendText{255, 255, 255};
+
+std::atomic<unsigned> gZFightTempCounter{0};
+
+bool writePngAtomic(const std::string &path, int w, int h, const std::vector<uint8_t> &rgb, std::string *err) {
+    const std::string tmp =
+        path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gZFightTempCounter.fetch_add(1));
+    auto fail = [&](const std::string &msg) {
+        std::remove(tmp.c_str());
+        if (err) *err = "cannot write image '" + path + "': " + msg;
+        return false;
+    };
+    auto out = OIIO::ImageOutput::create("png");
+    if (!out) return fail("no OpenImageIO PNG writer: " + OIIO::geterror());
+    const OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
+    if (!out->open(tmp, spec)) return fail(out->geterror());
+    if (!out->write_image(OIIO::TypeDesc::UINT8, rgb.data())) {
+        const std::string msg = out->geterror();
+        out->close();
+        return fail(msg);
+    }
+    if (!out->close()) return fail(out->geterror());
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) return fail(std::string("rename: ") + std::strerror(errno));
+    return true;
+}
+
+struct Canvas {
+    int w = 0, h = 0;
+    std::vector<uint8_t> *rgb = nullptr;
+    void set(int x, int y, Rgb8 c) {
+        if (x < 0 || y < 0 || x >= w || y >= h) return;
+        uint8_t *p = &(*rgb)[(size_t(y) * size_t(w) + size_t(x)) * 3];
+        p[0] = c.r, p[1] = c.g, p[2] = c.b;
+    }
+    void fill(int x0, int y0, int x1, int y1, Rgb8 c) {  // [x0, x1) x [y0, y1)
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) set(x, y, c);
+    }
+};
+
+// Legend layout, in multiples of the font scale s: a line is swatch 7s, gap 2s, label, gap 6s per
+// entry; lines are margin 3s + text 7s apart by 3s; entries wrap at the view's width.
+struct LegendEntry {
+    Rgb8 color;
+    std::string label;
+};
+
+}  // namespace
+
+Rgb8 zfightHotspotColor(uint32_t id) { return kPalette[(id == 0 ? 0 : id - 1) % 12]; }
+
+bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *out, std::string *err) {
+    const int W = zf.width, H = zf.height;
+    const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
+    if (W <= 0 || H <= 0 || zb.width != W || zb.height != H || zb.depth.size() != n || zf.pixelClass.size() != n ||
+        zf.hotspotOf.size() != n) {
+        if (err)
+            *err = "z-fighting image: the analysis (" + std::to_string(W) + "x" + std::to_string(H) +
+                   ") and the z-buffer (" + std::to_string(zb.width) + "x" + std::to_string(zb.height) +
+                   ") do not describe the same view (or their per-pixel buffers were released)";
+        return false;
+    }
+
+    // Legend entries and their wrapped lines.
+    const int s = W >= 1024 ? 2 : 1;
+    std::vector<LegendEntry> entries;
+    for (const ZFightHotspot &h : zf.hotspots) entries.push_back({zfightHotspotColor(h.id), "#" + std::to_string(h.id)});
+    if (zf.hotspotCount > zf.hotspots.size())
+        entries.push_back({kZFightOtherHotspotColor, "more (" + std::to_string(zf.hotspotCount - zf.hotspots.size()) + ")"});
+    if (zf.hotspotCount == 0) entries.push_back({kZFightStripBackground, "no hotspots"});
+    entries.push_back({kZFightSharedEdgeColor, "shared edge"});
+    entries.push_back({kZFightIntersectionColor, "intersection"});
+    const int margin = 3 * s, swatch = 7 * s, lineH = textHeight(s) + 3 * s;
+    auto entryWidth = [&](const LegendEntry &e) { return swatch + 2 * s + textWidth(e.label, s) + 6 * s; };
+    int maxEntry = 0;
+    for (const LegendEntry &e : entries) maxEntry = std::max(maxEntry, entryWidth(e));
+    const int CW = std::max(W, maxEntry + 2 * margin);
+    std::vector<int> lineOf(entries.size()), xOf(entries.size());
+    int line = 0, x = margin;
+    for (size_t i = 0; i < entries.size(); ++i) {
+        if (x > margin && x + entryWidth(entries[i]) > CW - margin) ++line, x = margin;
+        lineOf[i] = line;
+        xOf[i] = x;
+        x += entryWidth(entries[i]);
+    }
+    const int stripH = 2 * margin + (line + 1) * lineH;
+    const int CH = H + stripH;
+
+    ZFightImage img;
+    img.width = CW;
+    img.height = CH;
+    img.viewWidth = W;
+    img.viewHeight = H;
+    img.rgb.assign(size_t(CW) * size_t(CH) * 3, 0);
+    Canvas c{CW, CH, &img.rgb};
+    c.fill(0, 0, CW, CH, kZFightStripBackground);
+
+    // 1. Dimmed gray view; 2. markers.
+    double dMin = INFINITY, dMax = -INFINITY;
+    for (double d : zb.depth)
+        if (std::isfinite(d) && d > 0) dMin = std::min(dMin, d), dMax = std::max(dMax, d);
+    for (int y = 0; y < H; ++y)
+        for (int xx = 0; xx < W; ++xx) {
+            const size_t p = size_t(y) * size_t(W) + size_t(xx);
+            const uint8_t g = uint8_t(depthGray(zb.depth[p], dMin, dMax) / 2);
+            Rgb8 col{g, g, g};
+            const auto cls = ZPixelClass(zf.pixelClass[p]);
+            if (cls == ZPixelClass::shared_edge) col = kZFightSharedEdgeColor;
+            else if (cls == ZPixelClass::intersection) col = kZFightIntersectionColor;
+            c.set(xx, y, col);
+        }
+
+    // 3. Outlines and ids of the listed hotspots, largest (id 1) drawn first.
+    for (const ZFightHotspot &h : zf.hotspots) {
+        const Rgb8 col = zfightHotspotColor(h.id);
+        const int x0 = h.minX - 2, y0 = h.minY - 2, x1 = h.maxX + 2, y1 = h.maxY + 2;
+        for (int xx = std::max(x0, 0); xx <= std::min(x1, W - 1); ++xx) {
+            if (y0 >= 0) c.set(xx, y0, col);
+            if (y1 < H) c.set(xx, y1, col);
+        }
+        for (int y = std::max(y0, 0); y <= std::min(y1, H - 1); ++y) {
+            if (x0 >= 0 && x0 < W) c.set(x0, y, col);
+            if (x1 >= 0 && x1 < W) c.set(x1, y, col);
+        }
+        const std::string label = std::to_string(h.id);
+        const int ly = y0 - 1 - textHeight(s) >= 0 ? y0 - 1 - textHeight(s) : std::min(y1 + 2, H - textHeight(s));
+        // Only inside the view's rows: drawText clips to the w x h it is given (the canvas' rows
+        // above the strip).
+        if (ly >= 0) drawText(img.rgb.data(), CW, H, std::max(x0, 0), ly, label, {col.r, col.g, col.b}, s);
+    }
+
+    // 4. Hotspot pixels.
+    for (int y = 0; y < H; ++y)
+        for (int xx = 0; xx < W; ++xx) {
+            const uint32_t id = zf.hotspotOf[size_t(y) * size_t(W) + size_t(xx)];
+            if (!id) continue;
+            c.set(xx, y, id <= zf.hotspots.size() ? zfightHotspotColor(id) : kZFightOtherHotspotColor);
+        }
+
+    // 5. Legend.
+    for (size_t i = 0; i < entries.size(); ++i) {
+        const int ex = xOf[i], ey = H + margin + lineOf[i] * lineH;
+        if (entries[i].label != "no hotspots") c.fill(ex, ey, ex + swatch, ey + swatch, entries[i].color);
+        const int tx = entries[i].label == "no hotspots" ? ex : ex + swatch + 2 * s;
+        drawText(img.rgb.data(), CW, CH, tx, ey, entries[i].label, {kLegendText.r, kLegendText.g, kLegendText.b}, s);
+    }
+    *out = std::move(img);
+    return true;
+}
+
+bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::string &path, std::string *err) {
+    ZFightImage img;
+    std::string e;
+    if (!renderZFightImage(zf, zb, &img, &e)) {
+        if (err) *err = "cannot write image '" + path + "': " + e;
+        return false;
+    }
+    return writePngAtomic(path, img.width, img.height, img.rgb, err);
+}
+
+}  // namespace va
