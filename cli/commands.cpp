@@ -27,6 +27,7 @@
 #include "reports/depth_audit_report.h"
 #include "reports/depth_plot.h"
 #include "reports/budget.h"
+#include "reports/grade.h"
 #include "reports/merge.h"
 #include "reports/report.h"
 
@@ -53,6 +54,8 @@ struct Options {
     std::vector<std::string> mergeDirs;
     // check
     std::string budget, baseline, junit;
+    // grade
+    std::string reference, submission, tolerance, gradeOut;
 };
 
 void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
@@ -286,6 +289,54 @@ void addCheckOptions(CLI::App *c, Options &o) {
     c->add_option("--junit", o.junit, "Write JUnit XML here: one test case per view and budget");
 }
 
+// Reads a JSON file for grade/check; false + message naming the file.
+bool readJsonFile(const std::string &what, const std::string &path, nlohmann::ordered_json *out, std::string *err) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        *err = what + " " + path + ": cannot be read";
+        return false;
+    }
+    std::stringstream ss;
+    ss << f.rdbuf();
+    try {
+        *out = nlohmann::ordered_json::parse(ss.str());
+    } catch (const std::exception &e) {
+        *err = what + " " + path + ": not valid JSON (" + e.what() + ")";
+        return false;
+    }
+    return true;
+}
+
+int cmdGrade(const Options &o) {
+    std::string err;
+    nlohmann::ordered_json ref, sub;
+    ToleranceRules tol;
+    if (!readJsonFile("--reference", o.reference, &ref, &err) ||
+        !readJsonFile("--submission", o.submission, &sub, &err) ||
+        (!o.tolerance.empty() && !loadTolerances(o.tolerance, &tol, &err))) {
+        fail(err);
+        return kExitBadInput;
+    }
+    GradeResult g;
+    if (!gradeReports(ref, sub, tol, &g, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    std::printf("%s", gradeTable(g).c_str());
+    if (!o.gradeOut.empty() && !writeFileAtomic(o.gradeOut, gradeJson(g).dump(2) + "\n", &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    return g.failed ? kExitBudgetFailed : kExitOk;
+}
+
+void addGradeOptions(CLI::App *c, Options &o) {
+    c->add_option("--reference", o.reference, "The reference report.json")->required();
+    c->add_option("--submission", o.submission, "The student's report.json (the same keys)")->required();
+    c->add_option("--tolerance", o.tolerance, "Tolerances per metric (visaudit-tolerance/1)");
+    c->add_option("--out", o.gradeOut, "Write the result as JSON here");
+}
+
 int cmdMerge(const Options &o) {
     std::string err;
     OutputDir out;
@@ -405,6 +456,8 @@ const Command kCommands[] = {
      cmdAnalyze},
     {"check", "Analyze, then fail (exit 1) when a view exceeds its budget or regresses against a baseline",
      addCheckOptions, cmdCheck},
+    {"grade", "Score a student's per-stage counts against a reference report (exit 1 on any failure)",
+     addGradeOptions, cmdGrade},
     {"merge", "Join the reports of analyze --shard K/N runs into one report", addMergeOptions, cmdMerge},
     {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
      addDepthAuditOptions, cmdDepthAudit},

@@ -363,3 +363,49 @@ TEST_F(CliTest, CheckRefusesBadBudgetsAndBaselinesBeforeAnalysing) {
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("the baseline is a report of another scene"), std::string::npos) << r.err;
 }
+
+TEST_F(CliTest, GradeScoresADeliberatelyAlteredReport) {
+    ASSERT_EQ(run("analyze --quiet --out " + (dir_ / "ref").string()).code, 0);
+    const fs::path refPath = dir_ / "ref" / "report.json";
+    auto sub = nlohmann::json::parse(slurp(refPath));
+    // The same report grades 100%.
+    RunResult r = run("grade --reference " + refPath.string() + " --submission " + refPath.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("score 100.0%"), std::string::npos) << r.out;
+    // Three alterations: a clip count off by one, a ratio off by 1%, a stage left out.
+    ASSERT_EQ(sub["views"][0]["stages"][3]["name"], "clip");
+    const uint64_t rejected = sub["views"][0]["stages"][3]["trivially_rejected"];
+    sub["views"][0]["stages"][3]["trivially_rejected"] = rejected + 1;
+    const double overdraw = sub["views"][1]["zbuffer"]["overdraw"];
+    sub["views"][1]["zbuffer"]["overdraw"] = overdraw * 1.01;
+    ASSERT_EQ(sub["views"][1]["stages"][2]["name"], "backface");
+    const size_t backfaceKeys = 6;  // triangles_in/culled/out, tested, double_sided_exempt, edge_on
+    sub["views"][1]["stages"].erase(2);
+    const fs::path subPath = dir_ / "sub.json";
+    std::ofstream(subPath) << sub.dump();
+    r = run("grade --reference " + refPath.string() + " --submission " + subPath.string() + " --out " +
+            (dir_ / "grade.json").string());
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.out.find("FAIL spawn clip.trivially_rejected: submitted " + std::to_string(rejected + 1) +
+                         ", reference " + std::to_string(rejected)),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("FAIL overview zbuffer_summary.overdraw"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("FAIL overview backface.triangles_tested: submitted missing"), std::string::npos) << r.out;
+    const auto g = nlohmann::json::parse(slurp(dir_ / "grade.json"));
+    EXPECT_EQ(g["failed"], 2 + backfaceKeys);
+    // Tolerances forgive the first two, not the missing stage.
+    const fs::path tol = dir_ / "tol.json";
+    std::ofstream(tol) << R"({"format": "visaudit-tolerance/1",
+                              "metrics": {"clip.*": {"abs": 1}, "zbuffer_summary.overdraw": {"rel": 0.02}}})";
+    r = run("grade --reference " + refPath.string() + " --submission " + subPath.string() + " --tolerance " +
+            tol.string() + " --out " + (dir_ / "grade2.json").string());
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "grade2.json"))["failed"], backfaceKeys);
+    // A bad tolerance file: exit 2 with the place.
+    std::ofstream(tol) << R"({"format": "visaudit-tolerance/1", "metrics": {"clip.*": {"absolute": 1}}})";
+    r = run("grade --reference " + refPath.string() + " --submission " + subPath.string() + " --tolerance " +
+            tol.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("unknown key 'absolute' (known: abs, rel)"), std::string::npos) << r.err;
+}
