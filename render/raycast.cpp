@@ -64,6 +64,9 @@ struct RayGen {
 struct RayScene::Impl {
     RTCScene scene = nullptr;
     std::vector<uint32_t> primToSource;  // Embree primID -> global triangle id
+    std::vector<uint32_t> sourceToPrim;  // global triangle id -> Embree primID (kNoHit: not in the scene)
+    const float *vb = nullptr;           // Embree's vertex buffer (owned by the scene's geometry)
+    const unsigned *ib = nullptr;        // Embree's index buffer
     Vec3 origin;
     ~Impl() {
         if (scene) rtcReleaseScene(scene);
@@ -85,9 +88,23 @@ bool RayScene::build(const MeshView &mesh, size_t vertexCount, const std::vector
     m.origin = origin;
     m.scene = rtcNewScene(dev);
     // ROBUST: Embree's watertight intersection, so no ray slips between two triangles sharing an edge.
-    rtcSetSceneFlags(m.scene, RTC_SCENE_FLAG_ROBUST);
+    // CONTEXT_FILTER_FUNCTION: lets castPrimary's back-face rejection install a per-call filter; a
+    // context without a filter pays one pointer test per candidate hit.
+    if (!rtcGetDeviceProperty(dev, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED)) {
+        *err = "this Embree library was built without filter functions (EMBREE_FILTER_FUNCTION=OFF); "
+               "visaudit needs them for back-face rejection";
+        return false;
+    }
+    rtcSetSceneFlags(m.scene, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
     rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_HIGH);
     m.primToSource = triangles;
+    m.sourceToPrim.clear();
+    m.vb = nullptr;
+    m.ib = nullptr;
+    for (size_t k = 0; k < triangles.size(); ++k) {
+        if (triangles[k] >= m.sourceToPrim.size()) m.sourceToPrim.resize(size_t(triangles[k]) + 1, kNoHit);
+        m.sourceToPrim[triangles[k]] = uint32_t(k);
+    }
     if (!triangles.empty()) {
         RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
         float *vb = static_cast<float *>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -105,6 +122,8 @@ bool RayScene::build(const MeshView &mesh, size_t vertexCount, const std::vector
         }
         for (size_t k = 0; k < triangles.size(); ++k)
             for (int j = 0; j < 3; ++j) ib[3 * k + j] = mesh.indices[3 * size_t(triangles[k]) + j];
+        m.vb = vb;
+        m.ib = ib;
         rtcCommitGeometry(g);
         rtcAttachGeometry(m.scene, g);
         rtcReleaseGeometry(g);
@@ -139,6 +158,47 @@ void fillPacket(const RayGen &gen, const Camera &cam, int tx, int ty, RTCRayHit1
 }
 }  // namespace
 
+namespace {
+// castPrimary's back-face rejection: an intersect context extended with a per-primitive table
+// (Embree passes the context it was given to the filter, so the cast is safe).
+struct RejectContext {
+    RTCIntersectContext ctx;
+    const uint8_t *reject = nullptr;  // per Embree primitive: 1 = hits on it are rejected
+};
+void rejectFilter(const RTCFilterFunctionNArguments *args) {
+    const uint8_t *reject = reinterpret_cast<const RejectContext *>(args->context)->reject;
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] == -1 && reject[RTCHitN_primID(args->hit, args->N, i)]) args->valid[i] = 0;
+}
+
+// The tile loop shared by both castPrimary overloads (kBary: also write barycentrics).
+template <bool kBary>
+void castTiles(RTCScene scene, RTCIntersectContext *ctx, const RayGen &gen, const Camera &cam,
+               const std::vector<uint32_t> &primToSource, RaycastImage &img, RaycastStats &st) {
+    alignas(64) RTCRayHit16 rh;
+    alignas(64) int valid[16];
+    for (int ty = 0; ty < cam.height; ty += 4)
+        for (int tx = 0; tx < cam.width; tx += 4) {
+            fillPacket(gen, cam, tx, ty, rh, valid);
+            rtcIntersect16(valid, scene, ctx, &rh);
+            ++st.packets;
+            for (int i = 0; i < 16; ++i) {
+                if (!valid[i]) continue;
+                ++st.rays;
+                if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+                ++st.hits;
+                const size_t p = size_t(ty + (i >> 2)) * cam.width + (tx + (i & 3));
+                img.id[p] = 1 + primToSource[rh.hit.primID[i]];
+                img.depth[p] = rh.ray.tfar[i];
+                if constexpr (kBary) {
+                    img.u[p] = rh.hit.u[i];
+                    img.v[p] = rh.hit.v[i];
+                }
+            }
+        }
+}
+}  // namespace
+
 RaycastImage RayScene::castPrimary(const Camera &cam, RaycastStats *stats) const {
     const Impl &m = *impl_;
     RaycastImage img;
@@ -150,24 +210,63 @@ RaycastImage RayScene::castPrimary(const Camera &cam, RaycastStats *stats) const
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    alignas(64) RTCRayHit16 rh;
-    alignas(64) int valid[16];
     RaycastStats st;
-    for (int ty = 0; ty < cam.height; ty += 4)
-        for (int tx = 0; tx < cam.width; tx += 4) {
-            fillPacket(gen, cam, tx, ty, rh, valid);
-            rtcIntersect16(valid, m.scene, &ctx, &rh);
-            ++st.packets;
-            for (int i = 0; i < 16; ++i) {
-                if (!valid[i]) continue;
-                ++st.rays;
-                if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-                ++st.hits;
-                const size_t p = size_t(ty + (i >> 2)) * cam.width + (tx + (i & 3));
-                img.id[p] = 1 + m.primToSource[rh.hit.primID[i]];
-                img.depth[p] = rh.ray.tfar[i];
+    castTiles<false>(m.scene, &ctx, gen, cam, m.primToSource, img, st);
+    if (stats) *stats = st;
+    return img;
+}
+
+RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt, RaycastStats *stats) const {
+    const Impl &m = *impl_;
+    RaycastImage img;
+    img.width = cam.width;
+    img.height = cam.height;
+    const size_t n = size_t(cam.width) * cam.height;
+    img.id.assign(n, 0);
+    img.depth.assign(n, INFINITY);
+    if (opt.keepBarycentrics) {
+        img.u.assign(n, 0.0f);
+        img.v.assign(n, 0.0f);
+    }
+    const RayGen gen(cam, m.origin);
+    RejectContext rc;
+    rtcInitIntersectContext(&rc.ctx);
+    rc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    std::vector<uint8_t> reject;
+    if (opt.rejectBackFaces) {
+        // Which primitives are seen from their back, decided once per view with the backface stage's
+        // rule (plane at the eye > 0 is front; orthographic: n . forward < 0 is front; 0 is back).
+        const size_t prims = m.primToSource.size();
+        reject.assign(prims, 0);
+        for (size_t k = 0; k < prims; ++k) {
+            const uint32_t src = m.primToSource[k];
+            if (opt.doubleSided && opt.doubleSided[src]) continue;
+            Vec3 nrm;
+            double atEye;  // plane value at the eye (perspective)
+            if (opt.planes) {
+                const double *pl = opt.planes + 4 * size_t(src);
+                nrm = {pl[0], pl[1], pl[2]};
+                atEye = dot(nrm, cam.eye) + pl[3];
+            } else {
+                // The plane of Embree's own float triangle, in double, in the float frame.
+                const unsigned *tri = m.ib + 3 * k;
+                Vec3 v[3];
+                for (int j = 0; j < 3; ++j)
+                    v[j] = {m.vb[3 * size_t(tri[j])], m.vb[3 * size_t(tri[j]) + 1], m.vb[3 * size_t(tri[j]) + 2]};
+                nrm = cross(v[1] - v[0], v[2] - v[0]);
+                atEye = dot(nrm, gen.eyeRel - v[0]);
             }
+            const bool front = cam.orthographic ? dot(nrm, cam.forward) < 0 : atEye > 0;
+            reject[k] = front ? 0 : 1;
         }
+        rc.reject = reject.data();
+        rc.ctx.filter = rejectFilter;
+    }
+    RaycastStats st;
+    if (opt.keepBarycentrics)
+        castTiles<true>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
+    else
+        castTiles<false>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
     if (stats) *stats = st;
     return img;
 }
@@ -188,6 +287,69 @@ uint64_t RayScene::castPrimaryRaw(const Camera &cam) const {
             for (int i = 0; i < 16; ++i) hits += valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         }
     return hits;
+}
+
+LocalRay RayScene::primaryRay(const Camera &cam, int x, int y) const {
+    const RayGen gen(cam, impl_->origin);
+    LocalRay r;
+    gen.make(x, y, r.org, r.dir);
+    r.tnear = float(cam.nearZ);
+    r.tfar = float(cam.farZ);
+    return r;
+}
+
+LocalHit RayScene::intersect(const LocalRay &ray) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = ray.org[0], rh.ray.org_y = ray.org[1], rh.ray.org_z = ray.org[2];
+    rh.ray.dir_x = ray.dir[0], rh.ray.dir_y = ray.dir[1], rh.ray.dir_z = ray.dir[2];
+    rh.ray.tnear = ray.tnear;
+    rh.ray.tfar = ray.tfar;
+    rh.ray.time = 0;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(impl_->scene, &ctx, &rh);
+    LocalHit h;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return h;
+    h.prim = rh.hit.primID;
+    h.t = rh.ray.tfar;
+    h.u = rh.hit.u;
+    h.v = rh.hit.v;
+    h.ng[0] = rh.hit.Ng_x, h.ng[1] = rh.hit.Ng_y, h.ng[2] = rh.hit.Ng_z;
+    return h;
+}
+
+bool RayScene::occluded(const LocalRay &ray) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    r.org_x = ray.org[0], r.org_y = ray.org[1], r.org_z = ray.org[2];
+    r.dir_x = ray.dir[0], r.dir_y = ray.dir[1], r.dir_z = ray.dir[2];
+    r.tnear = ray.tnear;
+    r.tfar = ray.tfar;
+    r.time = 0;
+    r.mask = 0xFFFFFFFFu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(impl_->scene, &ctx, &r);
+    return r.tfar == -INFINITY;  // Embree marks an occluded ray with tfar = -inf
+}
+
+Vec3 RayScene::origin() const { return impl_->origin; }
+size_t RayScene::primitiveCount() const { return impl_->primToSource.size(); }
+uint32_t RayScene::sourceOf(uint32_t prim) const { return impl_->primToSource[prim]; }
+uint32_t RayScene::primitiveOf(uint32_t src) const {
+    return src < impl_->sourceToPrim.size() ? impl_->sourceToPrim[src] : kNoHit;
+}
+void RayScene::vertices(uint32_t prim, float v[9]) const {
+    const unsigned *tri = impl_->ib + 3 * size_t(prim);
+    for (int j = 0; j < 3; ++j)
+        for (int a = 0; a < 3; ++a) v[3 * j + a] = impl_->vb[3 * size_t(tri[j]) + a];
 }
 
 }  // namespace va
