@@ -1,0 +1,398 @@
+// Audits against the truth (audit.h; the definitions and constants are derived in docs/audits.md).
+#include "analysis/audit.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "render/raster.h"
+#include "render/raster_core.h"
+
+namespace va {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// The reference as a fragment sink: single-sided triangles only with the front winding, LESS on
+// the double depth with ties to the lowest id (so the order of submission does not matter).
+struct ReferenceSink {
+    const uint32_t *source;
+    const uint8_t *singleSided;
+    uint32_t *id;
+    double *depth;
+    uint32_t current = 0;  // 1 + source of the triangle being walked
+    uint64_t backWinding = 0, fragments = 0;
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const uint32_t s = source[t];
+        if (singleSided[s] && !frontWinding) {
+            ++backWinding;
+            return false;
+        }
+        current = s + 1;
+        return true;
+    }
+    void fragment(size_t i, size_t, double d) {
+        const double old = depth[i];
+        if (d < old || (d == old && current < id[i])) {
+            depth[i] = d;
+            id[i] = current;
+        }
+    }
+    void endTriangle(size_t, uint64_t n) { fragments += n; }
+};
+
+// Unit roundoff of float (Embree's arithmetic) and pbrt's gamma(n) = n u / (1 - n u): a bound on
+// the relative error of n successive roundings.
+constexpr double kFloatU = 0x1p-24;
+constexpr double gammaF(int n) { return n * kFloatU / (1 - n * kFloatU); }
+
+// A triangle seen from the camera: view-space vertices and the float-frame magnitudes the ray
+// caster's error depends on.
+struct ViewTriangle {
+    Vec3 P[3];           // view space
+    double M[3];         // |vertex - frame origin| + |eye - frame origin| (world units)
+    DepthPlane plane;
+};
+
+ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t) {
+    ViewTriangle v;
+    const double eyeFrame = length(cam.eye - rayOrigin);
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 w = scene.positions[scene.indices[3 * size_t(t) + i]];
+        v.P[i] = transformPoint(cam.viewFromWorld, w);
+        v.M[i] = length(w - rayOrigin) + eyeFrame;
+    }
+    v.plane = depthPlaneFromView(cam, v.P[0], v.P[1], v.P[2]);
+    return v;
+}
+
+// The ray caster's depth error for triangle v at (px, py), depth d: the hit point's error across
+// the plane (vertices and ray origin rounded to float: sqrt(3) u M each; the intersection's own
+// arithmetic: gamma(kEmbreeEdgeOps) of the magnitudes, t |D| and |Q|), turned into an error along
+// the ray by 1 / |n.D| (a grazing ray moves far along itself for a small move across the plane).
+double rayDepthError(const Camera &cam, const ViewTriangle &v, double px, double py, double d) {
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const Vec3 n = cross(v.P[1] - v.P[0], v.P[2] - v.P[0]);
+    const double nl = length(n);
+    double maxM = 0, maxQ = 0;
+    for (int i = 0; i < 3; ++i) {
+        maxM = std::max(maxM, v.M[i]);
+        maxQ = std::max(maxQ, length(v.P[i] - r.origin));
+    }
+    const double across = std::sqrt(3.0) * kFloatU * maxM + gammaF(kEmbreeEdgeOps) * (d * length(r.direction) + maxQ);
+    const double cosine = nl > 0 ? std::fabs(dot(n, r.direction)) / nl : 0;
+    return cosine > 0 ? across / cosine + kFloatU * d : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+// ---- Reference visibility ----------------------------------------------------------------------
+
+std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
+    std::vector<uint8_t> s(scene.triangleCount(), 0);
+    for (const SceneObject &o : scene.objects) {
+        if (scene.materialOf(o).doubleSided) continue;
+        for (uint32_t k = o.triBegin; k < o.triEnd; ++k) s[scene.objectTriangles[k]] = 1;
+    }
+    return s;
+}
+
+ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
+    const auto t0 = Clock::now();
+    ReferenceVisibility r;
+    r.width = std::max(cam.width, 0);
+    r.height = std::max(cam.height, 0);
+    const size_t pixels = size_t(r.width) * size_t(r.height);
+
+    // Every object's triangles, one clip batch per object (its vertex range is transformed once).
+    std::vector<ClipBatch> batches;
+    batches.reserve(scene.objects.size());
+    for (const SceneObject &o : scene.objects) {
+        if (o.triEnd == o.triBegin) continue;
+        batches.push_back({o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
+        r.trianglesIn += o.triEnd - o.triBegin;
+    }
+    const ClipResult clip =
+        clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{});
+    r.screenTriangles = clip.out.size();
+
+    r.id.assign(pixels, 0);
+    r.depth.assign(pixels, std::numeric_limits<double>::infinity());
+    const std::vector<uint8_t> single = singleSidedTriangles(scene);
+    ReferenceSink sink{clip.out.source.data(), single.data(), r.id.data(), r.depth.data()};
+    forEachFragment(clip.out, r.width, r.height, cam.orthographic, sink);
+    r.backWinding = sink.backWinding;
+    r.fragments = sink.fragments;
+
+    r.pixelsOf.assign(scene.triangleCount(), 0);
+    for (uint32_t id : r.id)
+        if (id) {
+            ++r.pixelsOf[id - 1];
+            ++r.coveredPixels;
+        }
+    std::vector<uint8_t> objectVisible(scene.objects.size(), 0);
+    for (size_t t = 0; t < r.pixelsOf.size(); ++t)
+        if (r.pixelsOf[t]) {
+            ++r.visibleTriangles;
+            objectVisible[scene.triangleObject[t]] = 1;
+        }
+    for (uint8_t v : objectVisible) r.visibleObjects += v;
+    r.ms = msSince(t0);
+    return r;
+}
+
+// ---- False culls and wasted draws ---------------------------------------------------------------
+
+CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const std::vector<StageCulls> &stages,
+                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource) {
+    const auto t0 = Clock::now();
+    CullAudit a;
+    const size_t nt = scene.triangleCount();
+
+    // The stage that culled each triangle first (1 + index; 0 = none). A per-pixel fate is a byte,
+    // 3 + k, so at most 253 stages (the pipeline has 5 culling stages).
+    const size_t nStages = std::min<size_t>(stages.size(), 255 - kFateCulledFirst + 1);
+    std::vector<uint8_t> culledBy(nt, 0);
+    a.stages.resize(nStages);
+    for (size_t k = 0; k < nStages; ++k) {
+        StageCullAudit &sa = a.stages[k];
+        sa.stage = stages[k].stage;
+        sa.objectsCulled = stages[k].objects.size();
+        auto cull = [&](uint32_t t) {
+            if (t < nt && culledBy[t] == 0 && scene.triangleObject[t] != kExcludedTriangle) {
+                culledBy[t] = uint8_t(k + 1);
+                ++sa.trianglesCulled;
+            }
+        };
+        for (uint32_t o : stages[k].objects) {
+            if (o >= scene.objects.size()) continue;
+            const SceneObject &ob = scene.objects[o];
+            for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) cull(scene.objectTriangles[i]);
+        }
+        for (uint32_t t : stages[k].triangles) cull(t);
+    }
+
+    // False culls: culled triangles that the reference shows; aggregated per object for the
+    // worst-offender lists.
+    struct Agg {
+        uint64_t triangles = 0, pixels = 0;
+    };
+    std::vector<std::unordered_map<uint32_t, Agg>> perObject(nStages);
+    for (size_t t = 0; t < nt; ++t) {
+        if (!culledBy[t] || !ref.pixelsOf.size() || ref.pixelsOf[t] == 0) continue;
+        const size_t k = culledBy[t] - 1;
+        StageCullAudit &sa = a.stages[k];
+        ++sa.falseCullTriangles;
+        sa.falseCullPixels += ref.pixelsOf[t];
+        Agg &g = perObject[k][scene.triangleObject[t]];
+        ++g.triangles;
+        g.pixels += ref.pixelsOf[t];
+    }
+    for (size_t k = 0; k < nStages; ++k) {
+        StageCullAudit &sa = a.stages[k];
+        sa.falseCullObjects = perObject[k].size();
+        for (const auto &[o, g] : perObject[k]) sa.worst.push_back({o, scene.objects[o].name, g.triangles, g.pixels});
+        std::sort(sa.worst.begin(), sa.worst.end(), [](const FalseCullOffender &x, const FalseCullOffender &y) {
+            if (x.pixels != y.pixels) return x.pixels > y.pixels;
+            if (x.triangles != y.triangles) return x.triangles > y.triangles;
+            return x.object < y.object;
+        });
+        if (sa.worst.size() > kWorstOffenders) sa.worst.resize(kWorstOffenders);
+        a.falseCullTriangles += sa.falseCullTriangles;
+        a.falseCullPixels += sa.falseCullPixels;
+    }
+
+    // Wasted draws: reached the z-buffer, visible nowhere in the reference.
+    std::vector<uint8_t> drawn(nt, 0);
+    std::vector<uint8_t> objectDrawn(scene.objects.size(), 0), objectVisible(scene.objects.size(), 0);
+    for (uint32_t t : drawnTriangles) {
+        if (t >= nt || drawn[t] || scene.triangleObject[t] == kExcludedTriangle) continue;
+        drawn[t] = 1;
+        ++a.drawnTriangles;
+        objectDrawn[scene.triangleObject[t]] = 1;
+        const uint64_t f = fragmentsPerSource && t < fragmentsPerSource->size() ? (*fragmentsPerSource)[t] : 0;
+        a.drawnFragments += f;
+        if (ref.pixelsOf[t] == 0) {
+            ++a.wastedTriangles;
+            a.wastedFragments += f;
+        }
+    }
+    for (size_t t = 0; t < nt; ++t)
+        if (ref.pixelsOf[t]) objectVisible[scene.triangleObject[t]] = 1;
+    for (size_t o = 0; o < scene.objects.size(); ++o) {
+        a.drawnObjects += objectDrawn[o];
+        a.wastedObjects += objectDrawn[o] && !objectVisible[o];
+    }
+
+    // Per-pixel fate of the reference's triangle (what reached the z-buffer shows as drawn even if
+    // a stage also listed it: the z-buffer drew it).
+    a.width = ref.width;
+    a.height = ref.height;
+    a.fate.assign(ref.id.size(), kFateBackground);
+    for (size_t i = 0; i < ref.id.size(); ++i) {
+        const uint32_t id = ref.id[i];
+        if (!id) continue;
+        const uint32_t t = id - 1;
+        if (drawn[t]) a.fate[i] = kFateDrawn;
+        else if (culledBy[t]) a.fate[i] = uint8_t(kFateCulledFirst + culledBy[t] - 1);
+        else {
+            a.fate[i] = kFateUnaccounted;
+            ++a.unaccountedPixels;
+        }
+    }
+    a.ms = msSince(t0);
+    return a;
+}
+
+// ---- Z-buffer against ray casting ---------------------------------------------------------------
+
+EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t, double px, double py) {
+    const ViewTriangle v = viewTriangle(scene, cam, rayOrigin, t);
+    EdgeDistance out;
+    // Orientation sign so that inside is positive: perspective, the sign of det[P0, P1, P2] (the
+    // edge function of edge 01 at the ray towards P2 is det); orthographic, minus the sign of the
+    // 2D area (the edge function below is -cross2). Zero: the triangle is seen edge-on, covers no
+    // area, and every point of it is on its boundary.
+    double sigma;
+    if (cam.orthographic) {
+        const double a2 = (v.P[1].x - v.P[0].x) * (v.P[2].y - v.P[0].y) - (v.P[1].y - v.P[0].y) * (v.P[2].x - v.P[0].x);
+        sigma = a2 > 0 ? -1 : (a2 < 0 ? 1 : 0);
+    } else {
+        const double det = dot(v.P[0], cross(v.P[1], v.P[2]));
+        sigma = det > 0 ? 1 : (det < 0 ? -1 : 0);
+    }
+    if (sigma == 0 || !v.plane.valid) {
+        out.nearEdge = true;
+        out.tolerancePx = kSnapEdgeTolerancePx;
+        return out;
+    }
+
+    // Edge i -> j as a function of the pixel: f(p) = ((Pi - O(p)) x (Pj - O(p))) . D(p), with the
+    // ray O + t D through p (camera.h: perspective O = 0, D affine in p; orthographic O affine in
+    // p, D = -z). f is zero where the ray meets the line through the edge (perspective: the ray
+    // lies in the plane through the eye and the edge, so no vertex is projected and vertices
+    // behind the eye need no care), and affine in p, so its gradient is an exact difference and
+    // f / |grad f| is the signed distance in pixels to the projected edge.
+    auto edgeF = [&](int i, int j, double x, double y) {
+        const ViewRay r = viewRayThroughPixel(cam, x, y);
+        return dot(cross(v.P[i] - r.origin, v.P[j] - r.origin), r.direction);
+    };
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const double dl = length(r.direction);
+    double minS = std::numeric_limits<double>::infinity(), minTol = kSnapEdgeTolerancePx;
+    bool allAbove = true;  // every constraint >= -tolerance
+    bool anyWithin = false;
+    auto take = [&](double s, double tol) {
+        if (s < -tol) allAbove = false;
+        if (s <= tol) anyWithin = true;
+        if (s < minS) {
+            minS = s;
+            minTol = tol;
+        }
+    };
+    for (int k = 0; k < 3; ++k) {
+        const int i = k, j = (k + 1) % 3;
+        const double f = edgeF(i, j, px, py);
+        const double gx = edgeF(i, j, px + 1, py) - f, gy = edgeF(i, j, px, py + 1) - f;
+        const double g = std::hypot(gx, gy);
+        const double qi = length(v.P[i] - r.origin), qj = length(v.P[j] - r.origin);
+        // The float ray caster's uncertainty of f (audit.h, kEmbreeEdgeOps).
+        const double df =
+            (gammaF(kEmbreeEdgeOps) * qi * qj + std::sqrt(3.0) * kFloatU * (v.M[i] * qj + v.M[j] * qi)) * dl;
+        if (g > 0) take(sigma * f / g, kSnapEdgeTolerancePx + df / g);
+        else take(sigma * f > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
+                  kSnapEdgeTolerancePx);
+    }
+
+    // The near and far planes cut the triangle along lines of constant depth: perspective
+    // 1/d = plane(p) (near: 1/near - plane >= 0, far: plane - 1/far >= 0), orthographic d = plane(p).
+    // The z-buffer clips exactly in double and snaps (kSnapEdgeTolerancePx); the ray caster limits
+    // t to [float(near), float(far)] and computes t in float (rayDepthError).
+    const double pv = evalDepthPlane(v.plane, px, py);
+    const double gp = std::hypot(v.plane.a, v.plane.b);
+    const double d = cam.orthographic ? pv : 1 / pv;
+    const double dErr = std::isfinite(d) && d > 0 ? rayDepthError(cam, v, px, py, d) : 0;
+    for (int side = 0; side < 2; ++side) {
+        const double limit = side == 0 ? cam.nearZ : cam.farZ;
+        double s, tolValue;
+        if (cam.orthographic) {
+            s = side == 0 ? pv - limit : limit - pv;
+            tolValue = dErr + kFloatU * limit;
+        } else {
+            s = side == 0 ? 1 / limit - pv : pv - 1 / limit;
+            tolValue = (dErr + kFloatU * limit) / (limit * limit);  // d(1/d) = dd / d^2
+        }
+        if (gp > 0) take(s / gp, kSnapEdgeTolerancePx + tolValue / gp);
+        else take(s >= 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
+                  kSnapEdgeTolerancePx);
+    }
+    out.signedPx = minS;
+    out.tolerancePx = minTol;
+    out.nearEdge = allAbove && anyWithin;
+    return out;
+}
+
+Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin,
+                                  int x, int y, uint32_t idA, uint32_t idB) {
+    if (idA == idB) return Disagreement::none;
+    const double px = x + 0.5, py = y + 0.5;
+    // Edge: who covers this center is decided by rounding, in either method, for either triangle.
+    for (uint32_t id : {idA, idB})
+        if (id && edgeDistance(scene, cam, rayOrigin, id - 1, px, py).nearEdge) return Disagreement::edge;
+    if (!idA || !idB) return Disagreement::genuine;
+    // Tie: both triangles' depths at the center, from their depth planes in double.
+    const ViewTriangle a = viewTriangle(scene, cam, rayOrigin, idA - 1);
+    const ViewTriangle b = viewTriangle(scene, cam, rayOrigin, idB - 1);
+    if (!a.plane.valid || !b.plane.valid) return Disagreement::genuine;
+    const double da = viewDepthAt(cam, a.plane, px, py), db = viewDepthAt(cam, b.plane, px, py);
+    if (depthKey(encoder, da) == depthKey(encoder, db)) return Disagreement::tie;
+    if (std::fabs(da - db) <= rayDepthError(cam, a, px, py, da) + rayDepthError(cam, b, px, py, db))
+        return Disagreement::tie;
+    return Disagreement::genuine;
+}
+
+CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector<double> &zbufferDepth,
+                      const std::vector<uint32_t> &raycastIds, const std::vector<float> &raycastDepth,
+                      const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin) {
+    const auto t0 = Clock::now();
+    CrossCheck c;
+    c.width = cam.width;
+    c.height = cam.height;
+    const size_t n = std::min({zbufferIds.size(), raycastIds.size(), size_t(cam.width) * size_t(cam.height)});
+    c.pixels = n;
+    c.cls.assign(n, uint8_t(Disagreement::none));
+    constexpr size_t kExamples = 16;
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t a = zbufferIds[i], b = raycastIds[i];
+        if (a == b) {
+            ++c.agree;
+            if (a && i < zbufferDepth.size() && i < raycastDepth.size() && zbufferDepth[i] > 0) {
+                const double rel = std::fabs(double(raycastDepth[i]) - zbufferDepth[i]) / zbufferDepth[i];
+                if (std::isfinite(rel)) c.maxRelativeDepthDifference = std::max(c.maxRelativeDepthDifference, rel);
+            }
+            continue;
+        }
+        const int x = int(i % size_t(cam.width)), y = int(i / size_t(cam.width));
+        const Disagreement k = classifyDisagreement(scene, cam, encoder, rayOrigin, x, y, a, b);
+        c.cls[i] = uint8_t(k);
+        if (!a || !b) ++c.oneSidedBackground;
+        switch (k) {
+        case Disagreement::edge: ++c.edge; break;
+        case Disagreement::tie: ++c.tie; break;
+        case Disagreement::genuine:
+            ++c.genuine;
+            if (c.genuineExamples.size() < kExamples) c.genuineExamples.push_back({x, y, a, b});
+            break;
+        case Disagreement::none: break;
+        }
+    }
+    c.ms = msSince(t0);
+    return c;
+}
+
+}  // namespace va

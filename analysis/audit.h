@@ -1,0 +1,176 @@
+// Audits against the truth (DESIGN.md, Audits; docs/audits.md): reference visibility with no
+// culling at all, the false culls and wasted draws of every culling stage, and the pixel-by-pixel
+// cross-check of the z-buffer against ray casting. Free functions over plain data; the pipeline
+// calls them per view (docs/audits.md, "Integration").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "analysis/scene.h"
+#include "render/camera.h"
+#include "render/clip.h"
+#include "render/depth_format.h"
+
+namespace va {
+
+// ---- Reference visibility ----------------------------------------------------------------------
+
+// Per source triangle: 1 when its material is single-sided (visible from its front only), 0 when
+// double-sided or excluded (degenerate, non-finite: in no object).
+std::vector<uint8_t> singleSidedTriangles(const Scene &scene);
+
+// The visible triangle at each pixel with no culling stage at all: every non-excluded triangle of
+// the scene is clipped (one batch per object) and rasterized through the z-buffer's own fragment
+// core (render/raster_core.h: same coverage, same double depth per pixel center), the depth test
+// in double (no depth format), ties to the lowest source id (explicitly, so submission order does
+// not matter). Single-sided triangles are seen from their front only -- that is what the material
+// means, not a culling decision -- and the front is decided by the projected winding on screen, as
+// hardware does, independently of the backface stage's plane test: so that stage is really audited.
+struct ReferenceVisibility {
+    int width = 0, height = 0;
+    std::vector<uint32_t> id;         // per pixel: 1 + visible source triangle, 0 = background
+    std::vector<double> depth;        // per pixel: its view depth (double), +inf = background
+    std::vector<uint32_t> pixelsOf;   // per source triangle: pixels where it is visible
+    uint64_t trianglesIn = 0;         // source triangles submitted (every non-excluded one)
+    uint64_t screenTriangles = 0;     // after clipping (fan pieces)
+    uint64_t backWinding = 0;         // single-sided screen triangles seen from behind: not drawn
+    uint64_t fragments = 0;           // pixel centers covered by drawn screen triangles
+    uint64_t visibleTriangles = 0;    // source triangles visible at one pixel or more
+    uint64_t visibleObjects = 0;      // culling objects with a visible triangle
+    uint64_t coveredPixels = 0;       // pixels showing a triangle
+    double ms = 0;                    // wall time (clip + rasterize + counts)
+};
+ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam);
+
+// ---- False culls and wasted draws ---------------------------------------------------------------
+
+// What one culling stage removed, as the pipeline ran it: whole culling objects (object-level
+// stages: cells, grid, frustum, occlusion) and/or single triangles (backface). A triangle of a
+// culled object need not be listed again.
+struct StageCulls {
+    std::string stage;                // "frustum", "backface", ...
+    std::vector<uint32_t> objects;    // culling objects culled as a whole
+    std::vector<uint32_t> triangles;  // source triangles culled individually
+};
+
+constexpr size_t kWorstOffenders = 20;
+
+struct FalseCullOffender {
+    uint32_t object = 0;              // culling object
+    std::string name;                 // its name (source name, "#k" for chunk k)
+    uint64_t triangles = 0;           // its falsely culled triangles (visible in the reference)
+    uint64_t pixels = 0;              // reference pixels they cover
+};
+
+struct StageCullAudit {
+    std::string stage;
+    uint64_t trianglesCulled = 0;     // triangles the stage removed (objects' triangles included)
+    uint64_t objectsCulled = 0;       // objects it removed as a whole
+    uint64_t falseCullTriangles = 0;  // culled, yet visible in the reference; best 0
+    uint64_t falseCullObjects = 0;    // objects with a falsely culled triangle; best 0
+    uint64_t falseCullPixels = 0;     // reference pixels showing a falsely culled triangle; best 0
+    std::vector<FalseCullOffender> worst;  // up to kWorstOffenders, most pixels first (ties: more
+                                           //   triangles, then lower object index)
+};
+
+// Per-pixel fate of the reference's visible triangle (CullAudit::fate).
+enum : uint8_t {
+    kFateBackground = 0,     // no triangle in the reference
+    kFateDrawn = 1,          // its triangle reached the z-buffer
+    kFateUnaccounted = 2,    // its triangle neither reached the z-buffer nor was culled by a listed
+                             //   stage (dropped elsewhere: a pipeline bug); best: no such pixel
+    kFateCulledFirst = 3,    // 3 + k: falsely culled by stages[k]
+};
+
+struct CullAudit {
+    std::vector<StageCullAudit> stages;   // in the order given (the pipeline's stage order)
+    uint64_t falseCullTriangles = 0;      // sums over the stages; best 0
+    uint64_t falseCullPixels = 0;         // best 0
+    uint64_t unaccountedPixels = 0;       // pixels of kFateUnaccounted; best 0
+    // Wasted draws: what reached the z-buffer (passed every culling stage) yet is visible nowhere
+    // in the reference. Best 0; the floor is set by what conservative object-level tests can know.
+    uint64_t drawnTriangles = 0;          // triangles that reached the z-buffer
+    uint64_t drawnObjects = 0;            // objects with a triangle that reached it
+    uint64_t wastedTriangles = 0;         // of drawnTriangles: invisible in the reference
+    uint64_t wastedObjects = 0;           // of drawnObjects: no triangle visible in the reference
+    uint64_t drawnFragments = 0;          // fragments the z-buffer rasterized (fragmentsPerSource)
+    uint64_t wastedFragments = 0;         // of them, of wasted triangles
+    std::vector<uint8_t> fate;            // per pixel, kFate*; for NAME.culling.png
+    int width = 0, height = 0;
+    double ms = 0;
+};
+
+// `drawnTriangles`: the source triangles that reached the z-buffer (the last culling stage's
+// output, TriangleLists::triangles). `fragmentsPerSource`: per source triangle, the fragments of
+// the pipeline's z-buffer pass (ZBufferSettings::fragmentsPerSource), or null (fragments 0).
+CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const std::vector<StageCulls> &stages,
+                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource);
+
+// ---- Z-buffer against ray casting ---------------------------------------------------------------
+
+enum class Disagreement : uint8_t {
+    none = 0,     // same triangle (or both background)
+    edge = 1,     // the pixel center is within the two methods' coverage error of an edge of either
+                  //   triangle (edgeTolerance below): who covers it is decided by rounding
+    tie = 2,      // both cover it and their depths at the center are equal in the view's depth
+                  //   format, or within the ray caster's float depth error: a depth tie
+    genuine = 3,  // neither: a real error in the rasterizer, the ray caster or a culling stage
+};
+
+// The coverage uncertainty, in pixels, of the two methods at an edge (docs/audits.md derives it):
+//  - the rasterizer snaps vertices to 1/2^kSubpixelBits px, round to nearest: each vertex moves at
+//    most 1/512 px per axis, sqrt(2)/512 px in all, and so does every point of a snapped edge
+//    (a convex combination of its endpoints);
+//  - Embree intersects in float: vertices rounded to float relative to the ray scene's origin,
+//    the ray's origin and direction rounded to float, and the edge test (a cross product and a dot
+//    product of float vectors) rounded; bounded per edge and pixel from the magnitudes involved as
+//    gamma(kEmbreeEdgeOps) |Qi| |Qj| |D| + u sqrt(3) (Mi |Qj| + Mj |Qi|) |D|, divided by the edge
+//    function's gradient in pixels (Qi: vertex relative to the ray origin, D: ray direction,
+//    Mi = |vertex - frame origin| + |ray origin - frame origin|).
+constexpr double kSnapEdgeTolerancePx = 1.4142135623730951 / 512;
+constexpr int kEmbreeEdgeOps = 16;
+
+struct CrossCheck {
+    int width = 0, height = 0;
+    uint64_t pixels = 0;            // pixels compared
+    uint64_t agree = 0;             // same visible triangle (or both background)
+    uint64_t edge = 0, tie = 0, genuine = 0;  // disagreements by class; best genuine == 0
+    uint64_t oneSidedBackground = 0;  // of the disagreements: one method saw background
+    double maxRelativeDepthDifference = 0;  // over agreeing covered pixels: |d_ray - d_z| / d_z (measured)
+    std::vector<uint8_t> cls;       // per pixel, Disagreement
+    struct Example {
+        int x = 0, y = 0;
+        uint32_t zbufferId = 0, raycastId = 0;  // 1 + id, 0 = background
+    };
+    std::vector<Example> genuineExamples;  // the first few genuine pixels (row-major), for messages
+    double ms = 0;
+};
+
+// Compares two id images of the same view (1 + source id, 0 = background), row-major
+// cam.width x cam.height: the z-buffer's (ids and double depths) and the ray caster's (ids and
+// float hit distances). `encoder`: the view's depth format (ties); `rayOrigin`: the float frame of
+// the ray scene (RayScene::build's origin), which the float error bound depends on.
+CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector<double> &zbufferDepth,
+                      const std::vector<uint32_t> &raycastIds, const std::vector<float> &raycastDepth,
+                      const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin);
+
+// The classification of one pixel (exposed for tests): idA, idB are 1 + source id (0 background),
+// idA != idB.
+Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin,
+                                  int x, int y, uint32_t idA, uint32_t idB);
+
+// Signed distance in pixels from pixel coordinates (px, py) to the boundary of the region where
+// source triangle t is seen in front of the near plane and behind the far plane (positive inside),
+// and the coverage tolerance there (see above); exposed for tests. Robust for triangles crossing
+// the near plane or with vertices behind the eye: each edge is the plane through the eye and the
+// edge (perspective), so no vertex is ever projected.
+struct EdgeDistance {
+    double signedPx = 0;     // min over the constraints of their signed distance
+    double tolerancePx = 0;  // tolerance of that constraint
+    bool nearEdge = false;   // every constraint >= -its tolerance and one <= its tolerance
+};
+EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t, double px, double py);
+
+}  // namespace va
