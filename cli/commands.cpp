@@ -46,6 +46,7 @@ struct Options {
     uint32_t chunk = 512;
     bool noBackface = false, noFrustum = false;
     bool quiet = false;
+    bool json = false;  // --json: the summary on stdout
     // depth-audit
     double nearZ = 0, farZ = 0;
     std::string formats;  // comma-separated; empty = all
@@ -206,8 +207,16 @@ int analyzeToReport(const Options &o,
         v.buffer = ZBuffer{};  // the images hold it now
         const int k = ++done;
         if (!o.quiet) {
+            // A terminal gets one line rewritten in place with an estimate of the time left; a log
+            // (CI) gets one plain line per view.
             std::lock_guard<std::mutex> lock(printMutex);
-            std::fprintf(stderr, tty ? "\r[%d/%zu] %s        " : "[%d/%zu] %s\n", k, views.size(), v.spec.name.c_str());
+            const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+            const double eta = elapsed / k * double(views.size() - size_t(k));
+            if (tty)
+                std::fprintf(stderr, "\r\033[K[%d/%zu] %s (%.1f s, about %.0f s left)", k, views.size(),
+                             v.spec.name.c_str(), elapsed, eta);
+            else
+                std::fprintf(stderr, "[%d/%zu] %s %.1f ms\n", k, views.size(), v.spec.name.c_str(), v.totalMs);
         }
         return true;
     };
@@ -227,7 +236,29 @@ int analyzeToReport(const Options &o,
         return kExitBadInput;
     }
     if (!err.empty()) std::fprintf(stderr, "visaudit: warning: %s\n", err.c_str());
-    if (!o.quiet) {
+    if (o.json) {
+        // For piping: the summary as one JSON document on stdout (the report minus nothing but
+        // per-stage detail: name, funnel and z-buffer summary per view, and the totals).
+        nlohmann::ordered_json summary;
+        summary["report"] = o.out + "/report.json";
+        summary["scene"] = (*report)["scene"];
+        nlohmann::ordered_json vs = nlohmann::ordered_json::array();
+        for (const auto &v : (*report)["views"]) {
+            nlohmann::ordered_json sv;
+            sv["name"] = v["name"];
+            nlohmann::ordered_json funnel = nlohmann::ordered_json::array();
+            for (const auto &st : v["stages"])
+                funnel.push_back({{"name", st["name"]}, {"ran", st["ran"]}, {"triangles_in", st["triangles_in"]},
+                                  {"triangles_culled", st["triangles_culled"]}, {"triangles_out", st["triangles_out"]}});
+            sv["stages"] = funnel;
+            sv["zbuffer"] = v["zbuffer"];
+            sv["zbuffer"].erase("histogram");
+            vs.push_back(sv);
+        }
+        summary["views"] = vs;
+        summary["totals"] = (*report)["totals"];
+        std::printf("%s\n", summary.dump(2).c_str());
+    } else if (!o.quiet) {
         for (const ViewResult &v : result.views) std::printf("%s\n", funnelTable(v).c_str());
         std::printf("report: %s/report.json\n", o.out.c_str());
     }
@@ -438,6 +469,7 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-backface", o.noBackface, "Turn the backface stage off");
     c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
+    c->add_flag("--json", o.json, "Print the summary as JSON on stdout (for piping); progress stays on stderr");
     c->add_option("--shard", o.shard, "Analyse only shard K of N: the views whose index i has i % N == K - 1 "
                                       "(join the shards with visaudit merge)");
 }

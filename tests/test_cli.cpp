@@ -409,3 +409,16 @@ TEST_F(CliTest, GradeScoresADeliberatelyAlteredReport) {
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("unknown key 'absolute' (known: abs, rel)"), std::string::npos) << r.err;
 }
+
+TEST_F(CliTest, JsonSummaryOnStdoutAndPlainProgressLinesWithoutATerminal) {
+    const RunResult r = run("analyze --json --out " + (dir_ / "out").string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);  // stdout is exactly one JSON document
+    const auto report = nlohmann::json::parse(slurp(dir_ / "out" / "report.json"));
+    EXPECT_EQ(summary["totals"]["fragments"], report["totals"]["fragments"]);
+    EXPECT_EQ(summary["views"][1]["stages"][2]["triangles_out"], report["views"][1]["stages"][2]["triangles_out"]);
+    // No terminal: one plain progress line per view on stderr, no carriage returns.
+    EXPECT_EQ(r.err.find('\r'), std::string::npos);
+    EXPECT_NE(r.err.find("[1/2] "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("[2/2] "), std::string::npos) << r.err;
+}
