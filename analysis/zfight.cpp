@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <unordered_map>
 
@@ -51,12 +52,14 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // depths, exactly like the z-buffer's LESS test on equal keys.
 struct TwoNearestSink {
     TwoNearest *out;
-    const uint32_t *source;  // ScreenTriangles::source
-    uint32_t current = 0;    // source triangle of the triangle being walked
+    const uint32_t *source;       // ScreenTriangles::source
+    const uint8_t *singleSided;   // as ZBufferSettings::singleSided (may be null)
+    uint32_t current = 0;         // source triangle of the triangle being walked
 
-    bool beginTriangle(size_t t, bool /*frontWinding*/) {
+    bool beginTriangle(size_t t, bool frontWinding) {
         current = source[t];
-        return true;
+        // The z-buffer skips single-sided triangles whose projected winding is the back one.
+        return !(singleSided && singleSided[current] && !frontWinding);
     }
     void fragment(size_t pixel, size_t t, double d) {
         double &d1 = out->depth1[pixel], &d2 = out->depth2[pixel];
@@ -86,7 +89,8 @@ struct TwoNearestSink {
 
 }  // namespace
 
-TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic) {
+TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic,
+                          const uint8_t *singleSided) {
     TwoNearest r;
     r.width = std::max(width, 0);
     r.height = std::max(height, 0);
@@ -96,7 +100,7 @@ TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bo
     r.screen1.assign(n, kNoFragment);
     r.screen2.assign(n, kNoFragment);
     if (n == 0) return r;
-    TwoNearestSink sink{&r, tris.source.data()};
+    TwoNearestSink sink{&r, tris.source.data(), singleSided};
     forEachFragment(tris, r.width, r.height, orthographic, sink);
     return r;
 }
@@ -317,7 +321,7 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     }
 
     // 1. Two nearest surfaces.
-    const TwoNearest two = findTwoNearest(tris, W, H, cam.orthographic);
+    const TwoNearest two = findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided);
     for (size_t p = 0; p < N; ++p) {
         if (two.screen1[p] != kNoFragment) ++r.coveredPixels;
         if (two.screen2[p] != kNoFragment) ++r.twoSurfacePixels;
@@ -329,15 +333,22 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
         const DepthEncoder enc = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
         const uint32_t bit = uint32_t(1) << i;
         uint64_t oor = 0;
+        // Shortcut for the (many) one-surface pixels, exact: every format clamps d into
+        // [minValidDepth, hi] with hi = far or +inf (render/depth_format_impl.h), so a depth in
+        // [minValidDepth, far] is never out of range and needs no encoding; others are encoded.
+        const double lo = enc.minValidDepth, hi = enc.farZ;
         dispatchDepthFormat(enc.format, [&]<DepthFormat Fmt>() {
             for (size_t p = 0; p < N; ++p) {
                 if (two.screen1[p] == kNoFragment) continue;
                 uint32_t k1 = 0, k2 = 0;
                 bool o1 = false, o2 = false;
-                encodeDepth<Fmt>(enc, two.depth1[p], k1, o1);
+                const double d1 = two.depth1[p];
                 if (two.screen2[p] != kNoFragment) {
+                    encodeDepth<Fmt>(enc, d1, k1, o1);
                     encodeDepth<Fmt>(enc, two.depth2[p], k2, o2);
                     if (k1 >= k2) r.fightMask[p] |= bit;
+                } else if (!(d1 >= lo && d1 <= hi)) {
+                    encodeDepth<Fmt>(enc, d1, k1, o1);
                 }
                 oor += (o1 || o2) ? 1 : 0;
             }
@@ -348,6 +359,7 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     // 3. Classify the pixels that fight somewhere: shared_edge, then intersection (never for
     //    coplanar triangles: they have no intersection line), then coplanar, else separated.
     PairCache pairs{scene, cam, {}};
+    double minSeparatedGap = kInf;  // smallest d2 - d1 over separated fighting pixels (for the text)
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             const size_t p = size_t(y) * size_t(W) + size_t(x);
@@ -367,6 +379,7 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
             else if (info.coplanar)
                 c = ZPixelClass::coplanar;
             r.pixelClass[p] = uint8_t(c);
+            if (c == ZPixelClass::separated) minSeparatedGap = std::min(minSeparatedGap, two.depth2[p] - two.depth1[p]);
             ++r.fightingPixelsAnyFormat;
             switch (c) {
             case ZPixelClass::separated: ++r.separatedPixels; break;
@@ -503,9 +516,11 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
                            ") with no fighting pixels in this view";
     } else {
         const uint64_t n = leastFighting->fightingPixels - leastFighting->coplanarPixels;
+        char gap[32];
+        std::snprintf(gap, sizeof gap, "%.3g", minSeparatedGap);
         r.recommendation = "every format fights at surfaces that are not coplanar (fewest: " + leastFighting->name +
-                           ", " + std::to_string(n) +
-                           " pixels): move the surfaces apart, push the near plane out or pull the far plane in";
+                           ", " + std::to_string(n) + " pixels; surfaces down to " + gap +
+                           " m apart): move the surfaces apart, push the near plane out or pull the far plane in";
     }
     if (r.coplanarPixels > 0)
         r.recommendation += "; coplanar surfaces fight in every format: offset the decal or use a depth bias (" +

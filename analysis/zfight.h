@@ -48,7 +48,9 @@ struct TwoNearest {
                                             // surface that produced the kept depth); kNoFragment = none
     size_t pixels() const { return depth1.size(); }
 };
-TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic);
+// singleSided: as ZBufferSettings::singleSided (null: every triangle is drawn).
+TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic,
+                          const uint8_t *singleSided = nullptr);
 
 // ---- Classes of a pixel with two surfaces -----------------------------------------------------
 
@@ -72,6 +74,9 @@ struct ZFightSettings {
                                     // still count as fighting pixels)
     size_t maxHotspotsListed = 50;  // hotspots kept with details (largest first); all are counted
     double sharedEdgePixels = 1.0;  // shared_edge radius: pixel center to projected edge, in pixels
+    // As ZBufferSettings::singleSided: per source triangle, nonzero = drawn only with the front
+    // winding on screen. Pass the pointer the view's z-buffer gets (null: every triangle counts).
+    const uint8_t *singleSided = nullptr;
 };
 
 struct ZFightFormatStats {

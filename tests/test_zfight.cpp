@@ -462,10 +462,18 @@ TEST(ZFightCases, ClosedMeshSharedEdgesAreNoHotspots) {
         EXPECT_EQ(ZPixelClass(r.pixelClass[size_t(k) * 64 + 28]), ZPixelClass::shared_edge) << "row " << k;
         EXPECT_EQ(ZPixelClass(r.pixelClass[size_t(28) * 64 + size_t(k)]), ZPixelClass::shared_edge) << "col " << k;
     }
-    // With backface culling (the pipeline's default) the side faces are not drawn at all.
+    // With backface culling (the pipeline's default) the side faces are not drawn at all; nor when
+    // every triangle is single-sided and only the projected winding decides (as the z-buffer's
+    // singleSided option does).
     const ZFightResult culled = analyzeZFighting(scene, cam, screenTriangles(scene, cam, true));
     EXPECT_EQ(culled.twoSurfacePixels, 0u);
     EXPECT_EQ(culled.fightingPixelsAnyFormat, 0u);
+    const std::vector<uint8_t> single(scene.triangleCount(), 1);
+    ZFightSettings ss;
+    ss.singleSided = single.data();
+    const ZFightResult winding = analyzeZFighting(scene, cam, screenTriangles(scene, cam, false), ss);
+    EXPECT_EQ(winding.coveredPixels, 49u);  // the top face: columns and rows 28..34
+    EXPECT_EQ(winding.twoSurfacePixels, 0u);
 }
 
 TEST(ZFightCases, WideRangeNear1e3Far1e6FormatsFollowTheirMath) {
@@ -531,8 +539,8 @@ TEST(ZFightCases, EveryFormatFightingMeansNoRecommendation) {
     }
     EXPECT_FALSE(r.recommended.has_value());
     EXPECT_EQ(r.recommendation,
-              "every format fights at surfaces that are not coplanar (fewest: linear_f32, 64 pixels): move the "
-              "surfaces apart, push the near plane out or pull the far plane in");
+              "every format fights at surfaces that are not coplanar (fewest: linear_f32, 64 pixels; surfaces down "
+              "to 1e-11 m apart): move the surfaces apart, push the near plane out or pull the far plane in");
 }
 
 TEST(ZFightCases, EmptyViewAndBadSettings) {
