@@ -520,7 +520,6 @@ TEST(ZFightCases, WideRangeNear1e3Far1e6FormatsFollowTheirMath) {
             EXPECT_EQ(s.outOfRangePixels, clampsBelow1 ? 4096u : 0u) << s.name;
         }
         EXPECT_EQ(r.recommended, DepthFormat::unorm24);
-        for (size_t p = 0; p < r.fightMask.size(); ++p) EXPECT_FALSE(std::isnan(double(r.fightMask[p])));
     }
 }
 
