@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/camera.h"
@@ -68,6 +70,96 @@ struct SceneObject {
 
 constexpr uint32_t kExcludedTriangle = 0xFFFFFFFFu;
 
+// ---- Quake 3 maps: the BSP tree, leafs, clusters and the PVS (docs/quake3.md) ---------------------
+
+// An entity of the map's entity lump: its "key" "value" pairs in file order.
+struct BspEntity {
+    std::vector<std::pair<std::string, std::string>> keys;
+    // The value of `key` (first occurrence), or nullptr.
+    const std::string *get(const std::string &key) const {
+        for (const auto &kv : keys)
+            if (kv.first == key) return &kv.second;
+        return nullptr;
+    }
+};
+
+struct BspPlane {
+    Vec3 normal;      // as stored (float, converted exactly)
+    double dist = 0;  // points p with dot(normal, p) == dist lie on the plane
+};
+
+struct BspNode {
+    uint32_t plane = 0;
+    // dot(normal, p) - dist >= 0: children[0] (front), else children[1] (back).
+    // A child >= 0 is a node (always after its parent: the loader checks it, so a walk ends);
+    // a child < 0 is leaf -(child + 1).
+    int32_t children[2] = {0, 0};
+};
+
+struct BspLeaf {
+    int32_t cluster = -1;  // -1: outside every cluster (solid, or the void outside the map)
+    int32_t area = -1;
+    Aabb bounds;           // as stored (integers)
+    uint32_t firstLeafFace = 0, leafFaceCount = 0;  // its faces: BspLevel::leafFaces[first, first + count)
+};
+
+// What the map's faces were, counted by kind (a face counts once, under the first rule that holds:
+// bad type, billboard, sky, nodraw, non-solid, else drawn by type).
+struct BspFaceCounts {
+    uint64_t faces = 0;         // faces in the file
+    uint64_t polygons = 0;      // drawn type-1 faces (planar polygons, triangles from meshverts)
+    uint64_t patches = 0;       // drawn type-2 faces (Bezier patches, tessellated)
+    uint64_t meshes = 0;        // drawn type-3 faces (triangle soups: models baked into the map)
+    uint64_t billboards = 0;    // type-4 faces (flares: a point, no geometry), skipped
+    uint64_t bad = 0;           // type-0 faces (MST_BAD: no geometry), skipped
+    uint64_t sky = 0;           // SURF_SKY (0x4): the sky box, excluded from objects
+    uint64_t nodraw = 0;        // SURF_NODRAW (0x80), SURF_HINT (0x100), SURF_SKIP (0x200): never drawn, excluded
+    uint64_t nonSolid = 0;      // water, slime, lava, fog volumes (contents 0x8/0x10/0x20/0x40): excluded
+    uint64_t polygonTriangles = 0, patchTriangles = 0, meshTriangles = 0;  // triangles of drawn faces by type
+    uint64_t skyTriangles = 0, nodrawTriangles = 0, nonSolidTriangles = 0;  // triangles of excluded faces
+    uint64_t unleafedFaces = 0; // drawn world faces no leaf references (object "unleafed", no cluster)
+    uint64_t modelFaces = 0;    // drawn faces of brush models 1.. (doors, platforms): objects "modelK"
+};
+
+// A Quake 3 map's visibility structure. Present only for scenes loaded from a .bsp.
+struct BspLevel {
+    std::vector<BspPlane> planes;
+    std::vector<BspNode> nodes;             // nodes[0] is the root (no nodes: the map is leaf 0)
+    std::vector<BspLeaf> leafs;
+    std::vector<uint32_t> leafFaces;        // face indices, ranges of it per leaf
+    int32_t clusterCount = 0;               // clusters: the PVS's rows (n_vecs), or 1 + the largest leaf cluster
+    uint32_t pvsRowBytes = 0;               // sz_vecs: bytes per PVS row
+    std::vector<uint8_t> pvs;               // clusterCount x pvsRowBytes; empty: no visdata (compiled without vis)
+    // Per source object (Scene::sources): its primary cluster (the leaf's; -1 none) and the set of
+    // every cluster any leaf holding one of its faces is in (sorted; empty: no cluster, always kept).
+    std::vector<int32_t> sourceCluster;
+    std::vector<uint32_t> sourceClustersBegin;  // size sources + 1: ranges into sourceClusters
+    std::vector<int32_t> sourceClusters;
+    std::vector<BspEntity> entities;
+    BspFaceCounts faceCounts;
+    int patchLevel = 0;                     // the tessellation level used (segments per patch edge)
+
+    bool hasPvs() const { return !pvs.empty(); }
+    // Cluster `from` sees cluster `to`: bit (to & 7) of byte pvs[from * rowBytes + to / 8]. Both must
+    // be in [0, clusterCount) and the map must have a PVS.
+    bool clusterVisible(int32_t from, int32_t to) const {
+        return (pvs[size_t(from) * pvsRowBytes + size_t(to >> 3)] >> (to & 7)) & 1;
+    }
+    // The leaf containing p: walk from the root, front (dot(n, p) - dist >= 0) or back child.
+    // Ends: children always come after their parent (checked when loading). -1 when there is no leaf.
+    int32_t leafAt(Vec3 p) const {
+        if (leafs.empty()) return -1;
+        if (nodes.empty()) return 0;
+        int32_t i = 0;
+        while (i >= 0) {
+            const BspNode &n = nodes[size_t(i)];
+            const BspPlane &pl = planes[n.plane];
+            i = n.children[dot(pl.normal, p) - pl.dist >= 0 ? 0 : 1];
+        }
+        return -(i + 1);
+    }
+};
+
 struct SceneStats {
     uint64_t sourceTriangles = 0;     // triangles in source order (ids 0 .. n-1)
     uint64_t degenerateTriangles = 0; // zero area (two equal vertices or collinear): excluded
@@ -93,6 +185,7 @@ struct Scene {
     Aabb bounds;
     SceneStats stats;
     std::vector<std::string> warnings;    // loader notes: dropped faces, ignored glTF features, ...
+    std::optional<BspLevel> bsp;          // Quake 3 maps: BSP tree, leafs, clusters, PVS, entities
 
     size_t triangleCount() const { return triangleObject.size(); }
     const Material &materialOf(const SceneObject &o) const { return materials[o.material]; }

@@ -2,6 +2,8 @@
 # Fetches the real-world test data into data/ (which is .gitignored):
 #   data/castle/level/level-dungeon.gltf + .bin   (castle-game-engine-doc: creature_behaviors example)
 #   data/cgal/elephant.off, data/cgal/armadillo.off (libcgal-demo: data.tar.gz)
+#   data/openarena/pak6-patch088.pk3 (openarena-088-data: maps/oa_thor.bsp, ...)
+#   data/openarena/pak1-maps.pk3     (openarena-081-maps: maps/q3dm6ish.bsp, maps/oa_dm1.bsp, ...)
 # Debian packages are fetched with `apt-get download` into a cache folder (no root needed to
 # download; `apt-get update` runs only when a download fails and we are root) and unpacked with
 # `dpkg -x`/`dpkg-deb --fsys-tarfile`, taking only the files we need. Idempotent: files already in
@@ -63,5 +65,24 @@ else
   echo "fetch-data: fetched $CGAL_OUT/elephant.off and armadillo.off from $(basename "$deb")"
 fi
 
+# 3. OpenArena maps (Quake 3 IBSP v46) in their .pk3 zip archives, as the game ships them: the
+#    tests read maps/oa_thor.bsp from pak6 and maps/q3dm6ish.bsp and maps/oa_dm1.bsp from pak1
+#    through the archive ("pak.pk3:maps/x.bsp"). Only the .pk3 is taken from each .deb.
+OA_OUT="$DATA/openarena"
+OA_SRC="usr/share/games/openarena/baseoa"
+mkdir -p "$OA_OUT"
+for pair in openarena-088-data:pak6-patch088.pk3 openarena-081-maps:pak1-maps.pk3; do
+  pkg="${pair%%:*}" pk3="${pair#*:}"
+  if [[ -s "$OA_OUT/$pk3" ]]; then
+    echo "fetch-data: $OA_OUT/$pk3 already present"
+    continue
+  fi
+  deb="$(fetch_deb "$pkg")"
+  # Into a temporary name first, so an interrupted run never leaves a partial archive behind.
+  dpkg-deb --fsys-tarfile "$deb" | tar -xO "./$OA_SRC/$pk3" > "$OA_OUT/$pk3.part"
+  mv "$OA_OUT/$pk3.part" "$OA_OUT/$pk3"
+  echo "fetch-data: fetched $OA_OUT/$pk3 from $(basename "$deb")"
+done
+
 echo "fetch-data: data in $DATA:"
-(cd "$DATA" && find . -type f \( -name '*.gltf' -o -name '*.bin' -o -name '*.off' \) -printf '  %p (%s bytes)\n' | sort)
+(cd "$DATA" && find . -type f \( -name '*.gltf' -o -name '*.bin' -o -name '*.off' -o -name '*.pk3' \) -printf '  %p (%s bytes)\n' | sort)

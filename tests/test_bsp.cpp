@@ -1,0 +1,988 @@
+// Quake 3 maps: the IBSP v46 loader (a tiny map written by the test itself, with exact counts),
+// hostile and truncated files refused with exact messages, pk3 archives, the PVS cells stage, level
+// views, and the OpenArena maps scripts/fetch-data.sh fetches (exact counts, a PVS row decoded by
+// hand, winding checked against the map's own normals).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <algorithm>
+#include <array>
+#include <map>
+#include <set>
+#include <unistd.h>
+
+#include "analysis/cells.h"
+#include "analysis/level_views.h"
+#include "analysis/load.h"
+#include "analysis/load_bsp.h"
+#include "analysis/zip.h"
+
+using namespace va;
+namespace fs = std::filesystem;
+
+namespace {
+
+// ---- A writer for minimal IBSP v46 files -----------------------------------------------------------
+
+enum { LEntities, LShaders, LPlanes, LNodes, LLeafs, LLeafFaces, LLeafBrushes, LModels, LBrushes,
+       LBrushSides, LVertexes, LMeshVerts, LEffects, LFaces, LLightmaps, LLightVols, LVisData };
+
+struct BspWriter {
+    std::vector<uint8_t> lump[17];
+    void i32(int l, int32_t v) {
+        uint32_t u = uint32_t(v);
+        for (int k = 0; k < 4; ++k) lump[l].push_back(uint8_t(u >> (8 * k)));
+    }
+    void f32(int l, float f) {
+        int32_t v;
+        std::memcpy(&v, &f, 4);
+        i32(l, v);
+    }
+    void bytes(int l, const std::string &s, size_t n) {  // n = npos: all of s
+        if (n == std::string::npos) n = s.size();
+        for (size_t k = 0; k < n; ++k) lump[l].push_back(k < s.size() ? uint8_t(s[k]) : 0);
+    }
+    void shader(const std::string &name, int32_t flags, int32_t contents) {
+        bytes(LShaders, name, 64);
+        i32(LShaders, flags);
+        i32(LShaders, contents);
+    }
+    void plane(Vec3 n, float d) {
+        f32(LPlanes, float(n.x)), f32(LPlanes, float(n.y)), f32(LPlanes, float(n.z)), f32(LPlanes, d);
+    }
+    void node(int32_t plane, int32_t front, int32_t back) {
+        i32(LNodes, plane), i32(LNodes, front), i32(LNodes, back);
+        for (int k = 0; k < 6; ++k) i32(LNodes, 0);
+    }
+    void leaf(int32_t cluster, Vec3 lo, Vec3 hi, int32_t firstFace, int32_t nFaces) {
+        i32(LLeafs, cluster), i32(LLeafs, 0);
+        i32(LLeafs, int32_t(lo.x)), i32(LLeafs, int32_t(lo.y)), i32(LLeafs, int32_t(lo.z));
+        i32(LLeafs, int32_t(hi.x)), i32(LLeafs, int32_t(hi.y)), i32(LLeafs, int32_t(hi.z));
+        i32(LLeafs, firstFace), i32(LLeafs, nFaces), i32(LLeafs, 0), i32(LLeafs, 0);
+    }
+    void model(Vec3 lo, Vec3 hi, int32_t face, int32_t nFaces) {
+        for (Vec3 v : {lo, hi}) f32(LModels, float(v.x)), f32(LModels, float(v.y)), f32(LModels, float(v.z));
+        i32(LModels, face), i32(LModels, nFaces), i32(LModels, 0), i32(LModels, 0);
+    }
+    int32_t vertex(Vec3 p, Vec3 n = {0, 0, 1}) {
+        const int32_t index = int32_t(lump[LVertexes].size() / 44);
+        f32(LVertexes, float(p.x)), f32(LVertexes, float(p.y)), f32(LVertexes, float(p.z));
+        for (int k = 0; k < 4; ++k) f32(LVertexes, 0);
+        f32(LVertexes, float(n.x)), f32(LVertexes, float(n.y)), f32(LVertexes, float(n.z));
+        i32(LVertexes, -1);
+        return index;
+    }
+    int32_t meshverts(std::initializer_list<int32_t> l) {
+        const int32_t first = int32_t(lump[LMeshVerts].size() / 4);
+        for (int32_t v : l) i32(LMeshVerts, v);
+        return first;
+    }
+    void face(int32_t shader, int32_t type, int32_t vertex, int32_t nVertexes, int32_t meshvert, int32_t nMeshverts,
+              int32_t w = 0, int32_t h = 0) {
+        i32(LFaces, shader), i32(LFaces, -1), i32(LFaces, type), i32(LFaces, vertex), i32(LFaces, nVertexes);
+        i32(LFaces, meshvert), i32(LFaces, nMeshverts);
+        for (int k = 0; k < 5; ++k) i32(LFaces, 0);     // lightmap index, start, size
+        for (int k = 0; k < 12; ++k) f32(LFaces, 0);    // lightmap origin, vectors, normal
+        i32(LFaces, w), i32(LFaces, h);
+    }
+    // Header + lumps in lump order; the last lump ends the file (no padding after it).
+    std::vector<uint8_t> file() const {
+        std::vector<uint8_t> out(8 + 8 * 17, 0);
+        std::memcpy(out.data(), "IBSP", 4);
+        out[4] = 46;
+        for (int l = 0; l < 17; ++l) {
+            while (out.size() % 4) out.push_back(0);
+            const uint32_t off = uint32_t(out.size()), len = uint32_t(lump[l].size());
+            for (int k = 0; k < 4; ++k) out[8 + 8 * l + k] = uint8_t(off >> (8 * k)), out[12 + 8 * l + k] = uint8_t(len >> (8 * k));
+            out.insert(out.end(), lump[l].begin(), lump[l].end());
+        }
+        return out;
+    }
+};
+
+void put32(std::vector<uint8_t> &f, size_t at, int32_t v) {
+    for (int k = 0; k < 4; ++k) f[at + k] = uint8_t(uint32_t(v) >> (8 * k));
+}
+int32_t get32(const std::vector<uint8_t> &f, size_t at) {
+    return int32_t(uint32_t(f[at]) | uint32_t(f[at + 1]) << 8 | uint32_t(f[at + 2]) << 16 | uint32_t(f[at + 3]) << 24);
+}
+size_t lumpOffset(const std::vector<uint8_t> &f, int l) { return size_t(get32(f, 8 + 8 * l)); }
+
+// The tiny map (docs/quake3.md has the same picture):
+//   plane 0: x = 0; plane 1: x = 100. Node 0 splits at x = 0: front (x >= 0) node 1, back leaf 1.
+//   Node 1 splits at x = 100: front leaf 2 (cluster -1: the void), back leaf 0.
+//   leaf 0: cluster 0, x in [0, 100]; leaf 1: cluster 1, x in [-100, 0]; leaf 2: the void.
+//   PVS: cluster 0 sees only 0, cluster 1 sees only 1.
+// Faces (shader 0 solid, 1 sky, 2 water):
+//   0 polygon quad on z = 0, x 10..90 (leaf 0)           2 triangles
+//   1 mesh triangle on z = 0, x -90..-10 (leaf 1)         1 triangle
+//   2 patch 3x3, flat at z = 8, x 20..80 (leaf 0)         2 L^2 triangles
+//   3 sky triangle (leaf 1)                               excluded
+//   4 billboard (leaf 0)                                  skipped
+//   5 water triangle (leaf 0)                             excluded (non-solid)
+//   6 triangle listed by leaf 0 and leaf 1                owned by leaf 0, clusters {0, 1}
+//   7 triangle no leaf lists (world)                      object "unleafed", no cluster
+//   8 quad of brush model 1 (a door in leaf 0's space)     object "model1", cluster 0 (its box)
+// Every face is stored clockwise seen from its front (+z), as Quake 3 stores them.
+BspWriter tinyWriter() {
+    BspWriter w;
+    w.bytes(LEntities,
+            "{\n\"classname\" \"worldspawn\"\n}\n"
+            "{\n\"classname\" \"info_player_deathmatch\"\n\"origin\" \"50 0 24\"\n\"angle\" \"90\"\n}\n"
+            "{\n\"classname\" \"info_player_start\"\n\"origin\" \"-50 0 24\"\n\"angles\" \"10 180 0\"\n}\n"
+            "// a comment\n"
+            "{\n\"classname\" \"info_player_intermission\"\n\"origin\" \"0 0 200\"\n\"target\" \"t1\"\n}\n"
+            "{\n\"classname\" \"target_position\"\n\"targetname\" \"t1\"\n\"origin\" \"50 0 0\"\n}\n",
+            std::string::npos);
+    w.lump[LEntities].push_back(0);
+    w.shader("textures/base/floor", 0, 1);
+    w.shader("textures/skies/sky", 0x4, 0);
+    w.shader("textures/liquids/water", 0, 0x20 | 0x20000000);
+    w.plane({1, 0, 0}, 0);
+    w.plane({1, 0, 0}, 100);
+    w.node(0, 1, -2);
+    w.node(1, -3, -1);
+    // leaffaces: leaf 0 -> 0, 2, 4, 5, 6; leaf 1 -> 1, 3, 6
+    for (int32_t f : {0, 2, 4, 5, 6, 1, 3, 6}) w.i32(LLeafFaces, f);
+    w.leaf(0, {0, -64, -16}, {100, 64, 128}, 0, 5);
+    w.leaf(1, {-100, -64, -16}, {0, 64, 128}, 5, 3);
+    w.leaf(-1, {100, -64, -16}, {200, 64, 128}, 8, 0);
+
+    // Face 0: quad, clockwise seen from +z: (10,40) (90,40) (90,-40) (10,-40).
+    int32_t v = w.vertex({10, 40, 0});
+    w.vertex({90, 40, 0}), w.vertex({90, -40, 0}), w.vertex({10, -40, 0});
+    w.face(0, 1, v, 4, w.meshverts({0, 1, 2, 0, 2, 3}), 6);
+    // Face 1: mesh triangle, clockwise from +z.
+    v = w.vertex({-90, 40, 0});
+    w.vertex({-10, 40, 0}), w.vertex({-10, -40, 0});
+    w.face(0, 3, v, 3, w.meshverts({0, 1, 2}), 3);
+    // Face 2: patch; control point (row i, column j) at (20 + 30 j, -30 + 30 i, 8). Quake 3's grid
+    // triangle (i,j) (i+1,j) (i,j+1) is then clockwise from +z: its front is +z.
+    v = -1;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            const int32_t k = w.vertex({20.0 + 30 * j, -30.0 + 30 * i, 8});
+            if (v < 0) v = k;
+        }
+    w.face(0, 2, v, 9, 0, 0, 3, 3);
+    // Face 3: sky triangle.
+    v = w.vertex({-90, 40, 120});
+    w.vertex({-10, 40, 120}), w.vertex({-10, -40, 120});
+    w.face(1, 1, v, 3, w.meshverts({0, 1, 2}), 3);
+    // Face 4: billboard (a point).
+    v = w.vertex({50, 0, 64});
+    w.face(0, 4, v, 1, 0, 0);
+    // Face 5: water triangle.
+    v = w.vertex({10, 40, -8});
+    w.vertex({90, 40, -8}), w.vertex({90, -40, -8});
+    w.face(2, 1, v, 3, w.meshverts({0, 1, 2}), 3);
+    // Face 6: a triangle across x = 0 (both leafs list it).
+    v = w.vertex({-20, 50, 4});
+    w.vertex({20, 50, 4}), w.vertex({20, 30, 4});
+    w.face(0, 1, v, 3, w.meshverts({0, 1, 2}), 3);
+    // Face 7: a world triangle no leaf lists.
+    v = w.vertex({40, 60, 2});
+    w.vertex({60, 60, 2}), w.vertex({60, 50, 2});
+    w.face(0, 1, v, 3, w.meshverts({0, 1, 2}), 3);
+    // Face 8: the door (model 1), a quad at x 20..30.
+    v = w.vertex({20, 10, 30});
+    w.vertex({30, 10, 30}), w.vertex({30, -10, 30}), w.vertex({20, -10, 30});
+    w.face(0, 1, v, 4, w.meshverts({0, 1, 2, 0, 2, 3}), 6);
+
+    w.model({-100, -64, -16}, {200, 64, 128}, 0, 8);
+    w.model({20, -10, 30}, {30, 10, 30}, 8, 1);
+    // PVS: 2 clusters, 1 byte per row: cluster 0 sees {0}, cluster 1 sees {1}.
+    w.i32(LVisData, 2), w.i32(LVisData, 1);
+    w.lump[LVisData].push_back(0x1);
+    w.lump[LVisData].push_back(0x2);
+    return w;
+}
+
+std::string parseError(const std::vector<uint8_t> &f, BspOptions opt = {}) {
+    SceneBuildInput in;
+    BspLevel lv;
+    std::string err;
+    EXPECT_FALSE(parseBsp(f.data(), f.size(), "tiny.bsp", opt, &in, &lv, &err));
+    return err;
+}
+
+std::string scratchDir() {
+    const std::string d = (fs::temp_directory_path() / ("visaudit_bsp_" + std::to_string(getpid()))).string();
+    fs::create_directories(d);
+    return d;
+}
+std::string writeFile(const std::string &name, const std::vector<uint8_t> &bytes) {
+    const std::string p = scratchDir() + "/" + name;
+    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char *>(bytes.data()), std::streamsize(bytes.size()));
+    return p;
+}
+
+Scene loadTiny(int patchLevel = 5) {
+    const std::string p = writeFile("tiny" + std::to_string(patchLevel) + ".bsp", tinyWriter().file());
+    Scene s;
+    std::string err;
+    BspOptions o;
+    o.patchLevel = patchLevel;
+    EXPECT_TRUE(loadBspScene(p, o, {}, &s, &err)) << err;
+    return s;
+}
+
+Camera cameraAt(const Scene &s, Vec3 eye, double yaw = 0) {
+    Camera c;
+    std::string err;
+    EXPECT_TRUE(makeCamera(quakeCamera(s, eye, yaw), &c, &err)) << err;
+    return c;
+}
+
+const SourceObject *sourceNamed(const Scene &s, const std::string &name) {
+    for (const auto &o : s.sources)
+        if (o.name == name) return &o;
+    return nullptr;
+}
+
+}  // namespace
+
+// ---- The tiny map: exact counts ----------------------------------------------------------------------
+
+TEST(Bsp, TinyMapObjectsAndCounts) {
+    const Scene s = loadTiny(5);
+    ASSERT_TRUE(s.bsp);
+    const BspLevel &lv = *s.bsp;
+    EXPECT_EQ(s.up, 'z');
+    // Objects: leaf0 (faces 0, 2, 6), leaf1 (face 1), model1 (face 8), unleafed (face 7).
+    ASSERT_EQ(s.sources.size(), 4u);
+    EXPECT_EQ(s.sources[0].name, "leaf0");
+    EXPECT_EQ(s.sources[1].name, "leaf1");
+    EXPECT_EQ(s.sources[2].name, "model1");
+    EXPECT_EQ(s.sources[3].name, "unleafed");
+    EXPECT_EQ(s.sources[0].triangleCount, 2u + 2 * 5 * 5 + 1);
+    EXPECT_EQ(s.sources[1].triangleCount, 1u);
+    EXPECT_EQ(s.sources[2].triangleCount, 2u);
+    EXPECT_EQ(s.sources[3].triangleCount, 1u);
+    EXPECT_EQ(s.triangleCount(), 57u);
+    EXPECT_EQ(s.stats.degenerateTriangles, 0u);
+    // Clusters per object: leaf0 {0, 1} (face 6 is also in leaf 1), leaf1 {1}, model1 {0} (its box
+    // lies in leaf 0), unleafed {}.
+    EXPECT_EQ(lv.sourceCluster, (std::vector<int32_t>{0, 1, -1, -1}));
+    EXPECT_EQ(lv.sourceClustersBegin, (std::vector<uint32_t>{0, 2, 3, 4, 4}));
+    EXPECT_EQ(lv.sourceClusters, (std::vector<int32_t>{0, 1, 1, 0}));
+    const BspFaceCounts &fc = lv.faceCounts;
+    EXPECT_EQ(fc.faces, 9u);
+    EXPECT_EQ(fc.polygons, 4u);
+    EXPECT_EQ(fc.patches, 1u);
+    EXPECT_EQ(fc.meshes, 1u);
+    EXPECT_EQ(fc.billboards, 1u);
+    EXPECT_EQ(fc.bad, 0u);
+    EXPECT_EQ(fc.sky, 1u);
+    EXPECT_EQ(fc.nodraw, 0u);
+    EXPECT_EQ(fc.nonSolid, 1u);
+    EXPECT_EQ(fc.polygonTriangles, 6u);
+    EXPECT_EQ(fc.patchTriangles, 50u);
+    EXPECT_EQ(fc.meshTriangles, 1u);
+    EXPECT_EQ(fc.skyTriangles, 1u);
+    EXPECT_EQ(fc.nonSolidTriangles, 1u);
+    EXPECT_EQ(fc.unleafedFaces, 1u);
+    EXPECT_EQ(fc.modelFaces, 1u);
+    EXPECT_EQ(lv.clusterCount, 2);
+    EXPECT_EQ(lv.pvsRowBytes, 1u);
+    EXPECT_EQ(lv.leafs.size(), 3u);
+    EXPECT_EQ(lv.nodes.size(), 2u);
+    EXPECT_EQ(lv.entities.size(), 5u);
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_EQ(s.warnings[0], s.path + ": kept out of the objects (docs/quake3.md): 1 sky, 0 nodraw, "
+                                      "1 non-solid see-through, 1 billboard and 0 bad faces");
+}
+
+TEST(Bsp, PatchLevelSetsTriangleCount) {
+    for (int L : {1, 2, 3, 8}) {
+        const Scene s = loadTiny(L);
+        EXPECT_EQ(s.bsp->faceCounts.patchTriangles, uint64_t(2 * L * L)) << "level " << L;
+        EXPECT_EQ(s.triangleCount(), uint64_t(2 + 2 * L * L + 1 + 1 + 2 + 1)) << "level " << L;
+    }
+    BspOptions o;
+    o.patchLevel = 0;
+    EXPECT_EQ(parseError(tinyWriter().file(), o), "tiny.bsp: patch level 0 is outside 1..64; choose e.g. 5 (--patch-level)");
+}
+
+// Quake 3 stores faces clockwise seen from the front; visaudit's front faces are counter-clockwise.
+// Every face of the tiny map faces +z, so every plane normal (v1 - v0) x (v2 - v0) must point up.
+TEST(Bsp, WindingReversedToCounterClockwise) {
+    const Scene s = loadTiny(3);
+    size_t checked = 0;
+    for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+        if (s.triangleObject[t] == kExcludedTriangle) continue;
+        // The patch's interior points are rounded (x = 20 + 60 t), so its normals may tilt by a few
+        // ulps; the z component must dominate by far.
+        const double *pl = &s.planes[4 * t];
+        EXPECT_GT(pl[2], 0) << "triangle " << t;
+        EXPECT_LT(std::abs(pl[0]) + std::abs(pl[1]), 1e-9 * pl[2]) << "triangle " << t;
+        ++checked;
+    }
+    EXPECT_EQ(checked, s.triangleCount());
+    // The patch is flat at z = 8 over x 20..80, y -30..30: tessellated vertices stay on it and the
+    // corners are exactly the control points.
+    const SceneObject &leaf0 = s.objects[s.sources[0].firstChunk];
+    std::set<std::pair<double, double>> patchCorners;
+    for (uint32_t v = leaf0.vertexBegin; v < leaf0.vertexEnd; ++v)
+        if (std::abs(s.positions[v].z - 8) < 1e-12) patchCorners.insert({s.positions[v].x, s.positions[v].y});
+    EXPECT_EQ(patchCorners.size(), 16u);  // (3 + 1)^2 grid points
+    EXPECT_TRUE(patchCorners.count({20, -30}) && patchCorners.count({80, 30}) && patchCorners.count({20, 30}) &&
+                patchCorners.count({80, -30}));
+}
+
+TEST(Bsp, LeafLookupWalksTheTree) {
+    const Scene s = loadTiny();
+    const BspLevel &lv = *s.bsp;
+    EXPECT_EQ(lv.leafAt({50, 0, 0}), 0);
+    EXPECT_EQ(lv.leafAt({-50, 0, 0}), 1);
+    EXPECT_EQ(lv.leafAt({150, 0, 0}), 2);
+    EXPECT_EQ(lv.leafAt({0, 0, 0}), 0);    // on plane 0: dot - dist = 0 >= 0 is the front
+    EXPECT_EQ(lv.leafAt({100, 0, 0}), 2);  // on plane 1: front
+    EXPECT_TRUE(lv.clusterVisible(0, 0));
+    EXPECT_FALSE(lv.clusterVisible(0, 1));
+    EXPECT_FALSE(lv.clusterVisible(1, 0));
+    EXPECT_TRUE(lv.clusterVisible(1, 1));
+}
+
+TEST(Bsp, EntitiesParsed) {
+    const Scene s = loadTiny();
+    const auto &e = s.bsp->entities;
+    ASSERT_EQ(e.size(), 5u);
+    EXPECT_EQ(*e[1].get("classname"), "info_player_deathmatch");
+    EXPECT_EQ(*e[1].get("origin"), "50 0 24");
+    EXPECT_EQ(e[1].get("nothing"), nullptr);
+    std::vector<BspEntity> out;
+    std::string err;
+    EXPECT_FALSE(parseBspEntities("{\n\"a\" \"b\"\n", &out, &err));
+    EXPECT_EQ(err, "line 3: entity not closed with '}'; the entity text is truncated");
+    EXPECT_FALSE(parseBspEntities("{\n\"a\" \"b\n", &out, &err));
+    EXPECT_EQ(err, "line 3: unterminated string; the entity text is truncated");
+    EXPECT_FALSE(parseBspEntities("\n\n x", &out, &err));
+    EXPECT_EQ(err, "line 3: expected '{' to open an entity, got 'x'");
+    EXPECT_FALSE(parseBspEntities("{ \"key\" }", &out, &err));
+    EXPECT_EQ(err, "line 1: expected a quoted string, got '}'");
+    EXPECT_TRUE(parseBspEntities("", &out, &err));
+    EXPECT_TRUE(out.empty());
+}
+
+TEST(Bsp, LoadSceneDispatchesBspAndPk3) {
+    const std::vector<uint8_t> bytes = tinyWriter().file();
+    const std::string loose = writeFile("dispatch.bsp", bytes);
+    Scene a, b, c;
+    std::string err;
+    ASSERT_TRUE(loadScene(loose, {}, &a, &err)) << err;
+    EXPECT_EQ(a.triangleCount(), 57u);
+    // The same map inside a pk3, deflated and stored; the member is found ignoring case.
+    for (bool deflate : {true, false}) {
+        const std::string pk3 = scratchDir() + (deflate ? "/deflated.pk3" : "/stored.pk3");
+        ASSERT_TRUE(writeZipArchive(pk3, {{"maps/readme.txt", {'h', 'i'}}, {"maps/Tiny.bsp", bytes}}, deflate, &err)) << err;
+        ASSERT_TRUE(loadScene(pk3 + ":maps/tiny.bsp", {}, &b, &err)) << err;
+        EXPECT_EQ(b.triangleCount(), 57u);
+        EXPECT_EQ(b.sources[0].mesh, pk3 + ":maps/tiny.bsp");
+        EXPECT_FALSE(loadScene(pk3 + ":maps/other.bsp", {}, &c, &err));
+        EXPECT_EQ(err, pk3 + ": no member 'maps/other.bsp' in the archive; members ending in '.bsp': maps/Tiny.bsp");
+    }
+    EXPECT_TRUE(isBspPath("a/b.BSP"));
+    EXPECT_TRUE(isBspPath("x/pak0.PK3:maps/q3dm1.bsp"));
+    EXPECT_FALSE(isBspPath("x/pak0.pk3:maps/q3dm1.aas"));
+    EXPECT_FALSE(isBspPath("level.json"));
+}
+
+TEST(Bsp, ArchiveErrors) {
+    std::string err;
+    std::vector<uint8_t> out;
+    const std::string notZip = writeFile("notzip.pk3", {'n', 'o', 't', ' ', 'a', ' ', 'z', 'i', 'p'});
+    EXPECT_FALSE(readZipMember(notZip, "maps/x.bsp", 1 << 20, &out, &err));
+    EXPECT_EQ(err, notZip + ": cannot open as a zip archive (Not a zip archive); a .pk3 must be a zip file: "
+                            "check the path, or test it with 'unzip -t'");
+    // A member larger than the limit is refused from the directory, before it is decompressed.
+    const std::string big = scratchDir() + "/big.pk3";
+    ASSERT_TRUE(writeZipArchive(big, {{"maps/big.bsp", std::vector<uint8_t>(5000, 7)}}, true, &err)) << err;
+    EXPECT_FALSE(readZipMember(big, "maps/big.bsp", 4096, &out, &err));
+    EXPECT_EQ(err, big + ":maps/big.bsp: member is 5000 bytes uncompressed, more than the limit of 4096 bytes; "
+                         "this is not a map (or raise the limit)");
+    // A corrupted deflate stream (bytes flipped inside the member's data) fails its read or CRC.
+    std::vector<uint8_t> z;
+    {
+        std::ifstream in(big, std::ios::binary);
+        z.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    ASSERT_GT(z.size(), 60u);
+    // The member's data starts after the 30-byte local header, its name and its extra field.
+    const size_t data = 30 + size_t(z[26] | z[27] << 8) + size_t(z[28] | z[29] << 8);
+    for (size_t k = data + 2; k < data + 12; ++k) z[k] ^= 0x5A;
+    const std::string bad = writeFile("bad.pk3", z);
+    EXPECT_FALSE(readZipMember(bad, "maps/big.bsp", 1 << 20, &out, &err));
+    EXPECT_EQ(err.rfind(bad + ":maps/big.bsp: cannot decompress the member (", 0), 0u) << err;
+    std::string archive, member;
+    EXPECT_TRUE(splitArchivePath("C:/games/pak0.pk3:maps/q3dm1.bsp", &archive, &member));
+    EXPECT_EQ(archive, "C:/games/pak0.pk3");
+    EXPECT_EQ(member, "maps/q3dm1.bsp");
+    EXPECT_FALSE(splitArchivePath("maps/q3dm1.bsp", &archive, &member));
+}
+
+// ---- Bad and hostile files: exact messages, refused before allocating -------------------------------
+
+TEST(Bsp, HeaderRefusals) {
+    std::vector<uint8_t> f = tinyWriter().file();
+    EXPECT_EQ(parseError(std::vector<uint8_t>(f.begin(), f.begin() + 100)),
+              "tiny.bsp: truncated: 100 bytes, but a Quake 3 map's header alone is 144 bytes; fetch the file again");
+    std::vector<uint8_t> g = f;
+    std::memcpy(g.data(), "VBSP", 4);
+    EXPECT_EQ(parseError(g), "tiny.bsp: not a Quake 3 map: the file starts with 'VBSP' (a Source engine map), "
+                             "expected 'IBSP'; visaudit reads Quake 3 maps (IBSP version 46)");
+    g = f;
+    put32(g, 4, 38);
+    EXPECT_EQ(parseError(g), "tiny.bsp: IBSP version 38 (a Quake 2 map) is not supported; visaudit reads Quake 3's version 46");
+    // A faces lump claiming 2 GB in a small file.
+    g = f;
+    const int32_t facesOff = get32(g, 8 + 8 * LFaces);
+    put32(g, 12 + 8 * LFaces, 0x7FFFFFF8);
+    EXPECT_EQ(parseError(g), "tiny.bsp: lump 'faces': bytes " + std::to_string(facesOff) + ".." +
+                                 std::to_string(int64_t(facesOff) + 0x7FFFFFF8) + " lie past the end of the file (" +
+                                 std::to_string(f.size()) + " bytes): the file is truncated or the header is damaged; fetch it again");
+    g = f;
+    put32(g, 8 + 8 * LPlanes, -4);
+    EXPECT_EQ(parseError(g), "tiny.bsp: lump 'planes': offset -4 and length 32 in the header: negative values; the header is damaged");
+    g = f;
+    put32(g, 12 + 8 * LLeafs, 47);
+    EXPECT_EQ(parseError(g), "tiny.bsp: lump 'leafs': length 47 is not a whole number of 48-byte records; the file is damaged");
+}
+
+// Every strict prefix of a valid file is refused (the last lump ends the file), without a crash.
+TEST(Bsp, EveryTruncationRefused) {
+    const std::vector<uint8_t> f = tinyWriter().file();
+    for (size_t n = 0; n < f.size(); ++n) {
+        SceneBuildInput in;
+        BspLevel lv;
+        std::string err;
+        ASSERT_FALSE(parseBsp(f.data(), n, "tiny.bsp", {}, &in, &lv, &err)) << "prefix of " << n << " bytes";
+        ASSERT_EQ(err.rfind("tiny.bsp: ", 0), 0u);
+    }
+    SceneBuildInput in;
+    BspLevel lv;
+    std::string err;
+    EXPECT_TRUE(parseBsp(f.data(), f.size(), "tiny.bsp", {}, &in, &lv, &err)) << err;
+}
+
+TEST(Bsp, IndexRefusals) {
+    const std::vector<uint8_t> f = tinyWriter().file();
+    const size_t faces = lumpOffset(f, LFaces), leafs = lumpOffset(f, LLeafs), nodes = lumpOffset(f, LNodes);
+    const size_t vis = lumpOffset(f, LVisData), leaffaces = lumpOffset(f, LLeafFaces), mv = lumpOffset(f, LMeshVerts);
+    auto with = [&](size_t at, int32_t v) {
+        std::vector<uint8_t> g = f;
+        put32(g, at, v);
+        return parseError(g);
+    };
+    // Face 0's vertex range (offset 12, count 16 in the record); the file has 38 vertices.
+    EXPECT_EQ(with(faces + 16, 40), "tiny.bsp: lump 'faces': face 0 vertex range 0..40 exceeds 33 vertices; the file is damaged");
+    EXPECT_EQ(with(faces + 12, -1), "tiny.bsp: lump 'faces': face 0 vertex range -1..3 exceeds 33 vertices; the file is damaged");
+    EXPECT_EQ(with(faces + 24, 600000000),
+              "tiny.bsp: lump 'faces': face 0 meshvert range 0..600000000 exceeds 27 meshverts; the file is damaged");
+    EXPECT_EQ(with(mv + 4, 4), "tiny.bsp: lump 'faces': face 0 meshvert 1 = 4 is outside the face's 4 vertices; the file is damaged");
+    EXPECT_EQ(with(faces + 8, 7), "tiny.bsp: lump 'faces': face 0 has type 7; Quake 3 knows 1 polygon, 2 patch, 3 mesh, "
+                                  "4 billboard; the file is damaged");
+    EXPECT_EQ(with(faces, 3), "tiny.bsp: lump 'faces': face 0 shader 3 is outside the 3 shaders; the file is damaged");
+    // Face 2 is the patch: an even width, and a grid larger than its vertices.
+    EXPECT_EQ(with(faces + 2 * 104 + 96, 4), "tiny.bsp: lump 'faces': face 2 is a patch of 4x3 control points; "
+                                             "patches need odd sizes of at least 3; the file is damaged");
+    EXPECT_EQ(with(faces + 2 * 104 + 96, 65535), "tiny.bsp: lump 'faces': face 2 is a patch of 65535x3 control points "
+                                                 "but has only 9 vertices; the file is damaged");
+    EXPECT_EQ(with(leaffaces + 4, 9), "tiny.bsp: lump 'leaffaces': leafface 1 names face 9, outside the 9 faces; the file is damaged");
+    EXPECT_EQ(with(leafs + 36, 9), "tiny.bsp: lump 'leafs': leaf 0 leafface range 0..9 exceeds the 8 leaffaces; the file is damaged");
+    EXPECT_EQ(with(leafs, 2), "tiny.bsp: lump 'visdata': leafs name cluster 2 but the PVS has 2 clusters; the file is damaged");
+    EXPECT_EQ(with(leafs, -7), "tiny.bsp: lump 'leafs': leaf 0 cluster -7 is below -1; the file is damaged");
+    EXPECT_EQ(with(nodes, 2), "tiny.bsp: lump 'nodes': node 0 plane 2 is outside the 2 planes; the file is damaged");
+    EXPECT_EQ(with(nodes + 36 + 4, 0), "tiny.bsp: lump 'nodes': node 1 child 0 does not come after its parent (a cycle); the file is damaged");
+    EXPECT_EQ(with(nodes + 36 + 4, 2), "tiny.bsp: lump 'nodes': node 1 child 2 is outside the 2 nodes; the file is damaged");
+    EXPECT_EQ(with(nodes + 8, -4), "tiny.bsp: lump 'nodes': node 0 child -4 names leaf 3, outside the 3 leafs; the file is damaged");
+    // Hostile PVS header: 2^31 - 1 clusters of 2^31 - 1 bytes would need 4.6 exabytes.
+    {
+        std::vector<uint8_t> g = f;
+        put32(g, vis, 0x7FFFFFFF);
+        put32(g, vis + 4, 0x7FFFFFFF);
+        EXPECT_EQ(parseError(g), "tiny.bsp: lump 'visdata': 2147483647 clusters x 2147483647 bytes = 4611686014132420609 "
+                                 "bytes of PVS, but the lump holds 2; the file is truncated or damaged");
+    }
+    EXPECT_EQ(with(vis, 9), "tiny.bsp: lump 'visdata': 9 clusters x 1 bytes = 9 bytes of PVS, but the lump holds 2; "
+                            "the file is truncated or damaged");
+    EXPECT_EQ(with(vis + 4, 0), "tiny.bsp: lump 'visdata': rows of 0 bytes cannot hold a bit for each of 2 clusters; the file is damaged");
+    // Entities: an unterminated string.
+    {
+        std::vector<uint8_t> g = f;
+        const size_t e = lumpOffset(g, LEntities);
+        g[e + 2] = 'x';  // {\n"classname" -> {\nx...
+        EXPECT_EQ(parseError(g), "tiny.bsp: lump 'entities': line 2: expected a quoted string, got 'x'");
+    }
+}
+
+// Hostile patch sizes would tessellate into billions of triangles: refused from the counts, before
+// a single triangle is allocated.
+TEST(Bsp, TriangleBudgetRefusedBeforeAllocating) {
+    BspOptions o;
+    o.patchLevel = 64;
+    o.maxTriangles = 1000;
+    EXPECT_EQ(parseError(tinyWriter().file(), o),
+              "tiny.bsp: the map's drawn faces would make 8199 triangles and 4242 vertices at patch level 64, more "
+              "than the limit of 1000 triangles; lower the patch level (--patch-level), or the file is damaged");
+    // Many faces sharing one large patch grid: 200 faces x 31 x 31 patches x 2 x 64^2.
+    BspWriter w = tinyWriter();
+    const int32_t first = int32_t(w.lump[LVertexes].size() / 44);
+    for (int k = 0; k < 63 * 63; ++k) w.vertex({double(k % 63), double(k / 63), 0});
+    w.lump[LFaces].clear();
+    for (int k = 0; k < 200; ++k) w.face(0, 2, first, 63 * 63, 0, 0, 63, 63);
+    w.lump[LLeafFaces].assign(32, 0);
+    w.lump[LModels].clear();
+    w.model({0, 0, 0}, {1, 1, 1}, 0, 200);
+    o.maxTriangles = BspOptions{}.maxTriangles;
+    EXPECT_EQ(parseError(w.file(), o),
+              "tiny.bsp: the map's drawn faces would make 1574502400 triangles and 788045000 vertices at patch level 64, "
+              "more than the limit of 50000000 triangles; lower the patch level (--patch-level), or the file is damaged");
+}
+
+// Seeded byte corruption: every file is either read or refused with a message; nothing crashes and
+// nothing reads out of bounds (the tests also run under the sanitizers of a debug build).
+TEST(Bsp, CorruptedBytesNeverCrash) {
+    const std::vector<uint8_t> f = tinyWriter().file();
+    uint64_t state = 12345;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return uint32_t(state >> 33);
+    };
+    int refused = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        std::vector<uint8_t> g = f;
+        const int flips = 1 + int(next() % 4);
+        for (int k = 0; k < flips; ++k) {
+            const size_t at = next() % g.size();
+            g[at] = uint8_t(next() % 3 == 0 ? 0xFF : next());
+        }
+        SceneBuildInput in;
+        BspLevel lv;
+        std::string err;
+        BspOptions o;
+        o.maxTriangles = 200000;
+        if (!parseBsp(g.data(), g.size(), "fuzz.bsp", o, &in, &lv, &err)) {
+            ++refused;
+            ASSERT_EQ(err.rfind("fuzz.bsp: ", 0), 0u) << err;
+        }
+    }
+    EXPECT_GT(refused, 100);
+}
+
+// ---- The cells stage ---------------------------------------------------------------------------------
+
+TEST(Cells, CullsInvisibleClustersFromASpawnPoint) {
+    const Scene s = loadTiny();
+    ASSERT_EQ(cellsSkipReason(s), nullptr);
+    // spawn0 stands in leaf 0 (cluster 0): leaf1 (cluster 1 only) is culled; leaf0, model1 and
+    // unleafed stay.
+    ASSERT_GE(s.views.size(), 1u);
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(s.views[0].camera, &cam, &err)) << err;
+    CellsResult r = cullCells(s, cam);
+    EXPECT_EQ(r.stats.cameraLeaf, 0);
+    EXPECT_EQ(r.stats.cameraCluster, 0);
+    EXPECT_FALSE(r.stats.cameraInVoid);
+    EXPECT_EQ(r.stats.clustersTotal, 2u);
+    EXPECT_EQ(r.stats.clustersVisible, 1u);
+    EXPECT_EQ(r.stats.objectsIn, 4u);
+    EXPECT_EQ(r.stats.objectsCulled, 1u);
+    EXPECT_EQ(r.stats.objectsNoCluster, 1u);
+    EXPECT_EQ(r.stats.trianglesIn, 57u);
+    EXPECT_EQ(r.stats.trianglesCulled, 1u);
+    EXPECT_EQ(r.visible, (std::vector<uint32_t>{0, 2, 3}));
+    EXPECT_TRUE(r.note.empty());
+    // From leaf 1 (cluster 1): model1 (cluster 0 only) is culled; leaf0 stays because face 6 is
+    // also in cluster 1 (conservative union).
+    r = cullCells(s, cameraAt(s, {-50, 0, 40}));
+    EXPECT_EQ(r.stats.cameraCluster, 1);
+    EXPECT_EQ(r.stats.objectsCulled, 1u);
+    EXPECT_EQ(r.stats.trianglesCulled, 2u);
+    EXPECT_EQ(r.visible, (std::vector<uint32_t>{0, 1, 3}));
+}
+
+TEST(Cells, CameraInTheVoidCullsNothing) {
+    const Scene s = loadTiny();
+    const CellsResult r = cullCells(s, cameraAt(s, {150, 0, 40}));
+    EXPECT_EQ(r.stats.cameraLeaf, 2);
+    EXPECT_EQ(r.stats.cameraCluster, -1);
+    EXPECT_TRUE(r.stats.cameraInVoid);
+    EXPECT_EQ(r.stats.objectsCulled, 0u);
+    EXPECT_EQ(r.stats.trianglesCulled, 0u);
+    EXPECT_EQ(r.stats.clustersVisible, 2u);
+    EXPECT_EQ(r.stats.objectsNoCluster, 1u);
+    EXPECT_EQ(r.visible, (std::vector<uint32_t>{0, 1, 2, 3}));
+    EXPECT_EQ(r.note, "camera in the void: leaf 2 is outside every cluster (outside the map or inside a wall); nothing culled");
+}
+
+TEST(Cells, SkipReasons) {
+    Scene plain;
+    EXPECT_STREQ(cellsSkipReason(plain), "scene has no cells, portals or PVS");
+    BspWriter w = tinyWriter();
+    w.lump[LVisData].clear();
+    const std::string p = writeFile("novis.bsp", w.file());
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadBspScene(p, {}, {}, &s, &err)) << err;
+    EXPECT_FALSE(s.bsp->hasPvs());
+    EXPECT_EQ(s.bsp->clusterCount, 2);
+    EXPECT_STREQ(cellsSkipReason(s), "map has no PVS (its visdata lump is empty: compiled without vis)");
+}
+
+// ---- Level views -------------------------------------------------------------------------------------
+
+TEST(LevelViews, SpawnPointsAtEyeHeight) {
+    const Scene s = loadTiny();
+    const std::vector<ViewSpec> v = spawnViews(s);
+    ASSERT_EQ(v.size(), 3u);
+    EXPECT_EQ(v[0].name, "spawn0");
+    EXPECT_EQ(v[0].origin, "spawns: info_player_deathmatch");
+    EXPECT_EQ(v[0].camera.eye, (Vec3{50, 0, 24 + 35}));
+    // angle 90: looking along +y.
+    const Vec3 d0 = v[0].camera.target - v[0].camera.eye;
+    EXPECT_NEAR(d0.x, 0, 1e-15);
+    EXPECT_DOUBLE_EQ(d0.y, 1);
+    EXPECT_EQ(d0.z, 0);
+    EXPECT_EQ(v[0].camera.up, (Vec3{0, 0, 1}));
+    EXPECT_NEAR(v[0].camera.fovYDegrees, 58.7155, 1e-4);
+    EXPECT_EQ(v[0].camera.nearZ, 4);
+    // angles "10 180 0": pitch 10 down, yaw 180.
+    EXPECT_EQ(v[1].name, "spawn1");
+    const Vec3 d1 = v[1].camera.target - v[1].camera.eye;
+    EXPECT_NEAR(d1.x, -std::cos(10 * kPi / 180), 1e-13);  // (eye + d) - eye rounds at 59
+    EXPECT_NEAR(d1.z, -std::sin(10 * kPi / 180), 1e-13);
+    // The intermission camera sits at its origin and aims at its target.
+    EXPECT_EQ(v[2].name, "intermission0");
+    EXPECT_EQ(v[2].camera.eye, (Vec3{0, 0, 200}));
+    EXPECT_EQ(v[2].camera.target, (Vec3{50, 0, 0}));
+    // loadBspScene makes them the scene's views.
+    ASSERT_EQ(s.views.size(), 3u);
+    EXPECT_EQ(s.views[1].camera.eye, v[1].camera.eye);
+}
+
+TEST(LevelViews, WalkIsSeededAndInsideClusters) {
+    const Scene s = loadTiny();
+    const std::vector<ViewSpec> a = walkViews(s, 20, 7), b = walkViews(s, 20, 7), c = walkViews(s, 20, 8);
+    ASSERT_EQ(a.size(), 20u);
+    int inLeaf0 = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].name, "walk" + std::to_string(i));
+        EXPECT_EQ(a[i].origin, "walk:20");
+        EXPECT_EQ(a[i].camera.eye, b[i].camera.eye);
+        EXPECT_EQ(a[i].camera.target, b[i].camera.target);
+        // Leaf 0's box center at floor + 50, or leaf 1's.
+        const Vec3 e = a[i].camera.eye;
+        EXPECT_TRUE(e == (Vec3{50, 0, -16 + 50}) || e == (Vec3{-50, 0, -16 + 50})) << e.x;
+        inLeaf0 += e.x > 0;
+        EXPECT_GE(s.bsp->leafs[size_t(s.bsp->leafAt(e))].cluster, 0);
+    }
+    EXPECT_GT(inLeaf0, 0);
+    EXPECT_LT(inLeaf0, 20);
+    bool differs = false;
+    for (size_t i = 0; i < a.size(); ++i) differs |= !(a[i].camera.target == c[i].camera.target);
+    EXPECT_TRUE(differs);
+}
+
+TEST(LevelViews, ViewsOptionValues) {
+    const Scene s = loadTiny();
+    std::vector<ViewSpec> v;
+    bool handled = false;
+    std::string err;
+    EXPECT_TRUE(levelViews("spawns", s, &v, &handled, &err));
+    EXPECT_TRUE(handled);
+    EXPECT_EQ(v.size(), 3u);
+    EXPECT_TRUE(levelViews("walk:5", s, &v, &handled, &err));
+    EXPECT_EQ(v.size(), 5u);
+    EXPECT_TRUE(levelViews("walk:5:99", s, &v, &handled, &err));
+    EXPECT_EQ(v[0].camera.eye, walkViews(s, 5, 99)[0].camera.eye);
+    EXPECT_TRUE(levelViews("orbit:4", s, &v, &handled, &err));
+    EXPECT_FALSE(handled);
+    EXPECT_FALSE(levelViews("walk:0", s, &v, &handled, &err));
+    EXPECT_EQ(err, "--views walk:0: expected walk:N or walk:N:SEED with N in 1..100000 and SEED a whole number, e.g. walk:16 or walk:16:7");
+    EXPECT_FALSE(levelViews("walk:3:x", s, &v, &handled, &err));
+    Scene plain;
+    plain.path = "box.obj";
+    EXPECT_FALSE(levelViews("spawns", plain, &v, &handled, &err));
+    EXPECT_EQ(err, "--views spawns: needs a Quake 3 map (.bsp); 'box.obj' is not one; use a views file, or orbit:N");
+}
+
+// ---- Real maps (scripts/fetch-data.sh) ---------------------------------------------------------------
+
+namespace {
+
+const std::string kOa = std::string(VISAUDIT_SOURCE_DIR) + "/data/openarena/";
+
+// Reads a map's raw bytes from its pk3 (for the independent decoding below).
+std::vector<uint8_t> rawMap(const std::string &pk3, const std::string &member) {
+    std::vector<uint8_t> b;
+    std::string err;
+    EXPECT_TRUE(readZipMember(kOa + pk3, member, 1u << 30, &b, &err)) << err;
+    return b;
+}
+
+}  // namespace
+
+#define REQUIRE_OA(file) \
+    if (!fs::exists(kOa + file)) GTEST_SKIP() << kOa << file << " is absent: run scripts/fetch-data.sh to fetch it"
+
+// Counts of a real map, printed for the record and compared with the values measured when the
+// test was written (docs/quake3.md lists them).
+struct MapCounts {
+    uint64_t triangles, degenerate, objects, sources, clusters, leafs, faces, polygons, patches, meshes,
+        billboards, sky, nodraw, nonSolid, polygonTriangles, patchTriangles, meshTriangles, views;
+};
+MapCounts countsOf(const Scene &s) {
+    const BspFaceCounts &fc = s.bsp->faceCounts;
+    return {s.triangleCount(), s.stats.degenerateTriangles, s.objects.size(), s.sources.size(),
+            uint64_t(s.bsp->clusterCount), s.bsp->leafs.size(), fc.faces, fc.polygons, fc.patches, fc.meshes,
+            fc.billboards, fc.sky, fc.nodraw, fc.nonSolid, fc.polygonTriangles, fc.patchTriangles, fc.meshTriangles,
+            s.views.size()};
+}
+void expectCounts(const Scene &s, const MapCounts &want) {
+    const MapCounts got = countsOf(s);
+    const char *names[] = {"triangles", "degenerate", "objects", "sources", "clusters", "leafs", "faces", "polygons",
+                           "patches", "meshes", "billboards", "sky", "nodraw", "nonSolid", "polygonTriangles",
+                           "patchTriangles", "meshTriangles", "views"};
+    const uint64_t *g = &got.triangles, *w = &want.triangles;
+    for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); ++k) {
+        std::printf("%s%s %llu", k ? ", " : "  ", names[k], (unsigned long long)g[k]);
+        EXPECT_EQ(g[k], w[k]) << names[k];
+    }
+    std::printf("\n");
+    const BspFaceCounts &fc = s.bsp->faceCounts;
+    // Every face is counted under exactly one kind, and the drawn faces' triangles are the scene's.
+    EXPECT_EQ(fc.polygons + fc.patches + fc.meshes + fc.billboards + fc.bad + fc.sky + fc.nodraw + fc.nonSolid, fc.faces);
+    EXPECT_EQ(fc.polygonTriangles + fc.patchTriangles + fc.meshTriangles, s.triangleCount());
+}
+
+Scene loadReal(const std::string &path) {
+    Scene s;
+    std::string err;
+    EXPECT_TRUE(loadScene(path, {}, &s, &err)) << err;
+    return s;
+}
+
+// The PVS as a test decodes it straight from the file's bytes: header -> lump 16 -> rows.
+struct RawPvs {
+    int32_t n = 0, sz = 0;
+    std::vector<uint8_t> rows;
+    bool sees(int32_t x, int32_t y) const { return rows[size_t(x) * size_t(sz) + size_t(y / 8)] & (1 << (y % 8)); }
+};
+RawPvs rawPvs(const std::vector<uint8_t> &f) {
+    RawPvs p;
+    const size_t off = size_t(get32(f, 8 + 8 * 16));
+    p.n = get32(f, off), p.sz = get32(f, off + 4);
+    p.rows.assign(f.begin() + long(off) + 8, f.begin() + long(off) + 8 + long(p.n) * p.sz);
+    return p;
+}
+
+TEST(Bsp, RealQ3dm6ishPvsRowDecodedByHand) {
+    REQUIRE_OA("pak1-maps.pk3");
+    const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/q3dm6ish.bsp");
+    ASSERT_TRUE(s.bsp && s.bsp->hasPvs());
+    const BspLevel &lv = *s.bsp;
+    ASSERT_EQ(lv.clusterCount, 247);
+    ASSERT_EQ(lv.pvsRowBytes, 32u);
+    // Cluster 10's row, read with a hex dump of the file (visdata at 8 + 10 * 32 bytes into lump 16):
+    //   85 0c 10 09 a0 05 00 00 00 00 00 00 00 00 00 00 00 a4 be 17 20 00 18 a0 49 01 00 10 45 02 00 00
+    // 0x85 = bits 0, 2, 7 -> clusters 0, 2, 7; 0x0c -> 10, 11; 0x10 -> 20; 0x09 -> 24, 27; ...
+    const std::vector<int32_t> row10 = {0,   2,   7,   10,  11,  20,  24,  27,  37,  39,  40,  42,  138,
+                                        141, 143, 145, 146, 147, 148, 149, 151, 152, 153, 154, 156, 165,
+                                        179, 180, 189, 191, 192, 195, 198, 200, 220, 224, 226, 230, 233};
+    std::vector<int32_t> seen;
+    for (int32_t y = 0; y < lv.clusterCount; ++y)
+        if (lv.clusterVisible(10, y)) seen.push_back(y);
+    EXPECT_EQ(seen, row10);
+    // Every row, against the test's own decoding of the raw bytes.
+    const RawPvs raw = rawPvs(rawMap("pak1-maps.pk3", "maps/q3dm6ish.bsp"));
+    ASSERT_EQ(raw.n, lv.clusterCount);
+    uint64_t mismatches = 0, visible = 0;
+    for (int32_t x = 0; x < raw.n; ++x)
+        for (int32_t y = 0; y < raw.n; ++y) {
+            mismatches += raw.sees(x, y) != lv.clusterVisible(x, y);
+            visible += raw.sees(x, y);
+        }
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_GT(visible, 0u);
+}
+
+TEST(Bsp, RealQ3dm6ish) {
+    REQUIRE_OA("pak1-maps.pk3");
+    const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/q3dm6ish.bsp");
+    // triangles, degenerate, objects, sources, clusters, leafs, faces, polygons, patches, meshes,
+    // billboards, sky, nodraw, nonSolid, polygon/patch/mesh triangles, views (10 deathmatch + 1 start)
+    expectCounts(s, {2621, 0, 231, 231, 247, 650, 907, 907, 0, 0, 0, 0, 0, 0, 2621, 0, 0, 11});
+}
+
+TEST(Bsp, RealOaDm1) {
+    REQUIRE_OA("pak1-maps.pk3");
+    const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/oa_dm1.bsp");
+    // 7 deathmatch + 1 start + 1 intermission views; 30 non-solid (beams, lava); 10 meshes, 10 flares.
+    expectCounts(s, {7448, 26, 241, 240, 422, 1123, 902, 852, 0, 10, 10, 0, 0, 30, 4348, 0, 3100, 9});
+}
+
+TEST(Bsp, RealOaThor) {
+    REQUIRE_OA("pak6-patch088.pk3");
+    const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
+    // 170 player spawns (58 info_player_start, 2 x 17 team_CTF_*player, 2 x 39 team_CTF_*spawn) and 1
+    // intermission; 1292 non-solid faces (light beams), 6 sky faces; patches at level 5.
+    expectCounts(s, {43185, 205, 2297, 2269, 2825, 5373, 11211, 9831, 82, 0, 0, 6, 0, 1292, 26785, 16400, 0, 171});
+    EXPECT_EQ(s.bsp->pvsRowBytes, 360u);
+    EXPECT_EQ(s.bsp->nodes.size(), 5355u);
+    // The same map read loose (written out of the archive) gives the same scene.
+    const std::vector<uint8_t> bytes = rawMap("pak6-patch088.pk3", "maps/oa_thor.bsp");
+    const Scene loose = loadReal(writeFile("oa_thor.bsp", bytes));
+    EXPECT_EQ(loose.triangleCount(), s.triangleCount());
+    EXPECT_EQ(loose.positions, s.positions);
+    EXPECT_EQ(loose.bsp->pvs, s.bsp->pvs);
+}
+
+// Quake 3's winding, checked against the map's own normals: each polygon face stores its plane's
+// normal; the triangles as the file stores them, reversed, must face the same way (their normal's
+// dot product with it positive). The scene must then hold exactly those reversed triangles.
+TEST(Bsp, RealWindingAgreesWithStoredNormals) {
+    REQUIRE_OA("pak6-patch088.pk3");
+    const std::vector<uint8_t> f = rawMap("pak6-patch088.pk3", "maps/oa_thor.bsp");
+    const size_t faces = lumpOffset(f, LFaces), verts = lumpOffset(f, LVertexes), mv = lumpOffset(f, LMeshVerts);
+    const size_t nFaces = size_t(get32(f, 12 + 8 * LFaces)) / 104;
+    auto fl = [&](size_t at) {
+        float x;
+        int32_t i = get32(f, at);
+        std::memcpy(&x, &i, 4);
+        return double(x);
+    };
+    auto pos = [&](int32_t v) { return Vec3{fl(verts + 44 * size_t(v)), fl(verts + 44 * size_t(v) + 4), fl(verts + 44 * size_t(v) + 8)}; };
+    auto nrm = [&](int32_t v) { return Vec3{fl(verts + 44 * size_t(v) + 28), fl(verts + 44 * size_t(v) + 32), fl(verts + 44 * size_t(v) + 36)}; };
+    // Rotation-normalized triangle keys of the scene's triangles.
+    const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
+    auto key = [](Vec3 a, Vec3 b, Vec3 c) {
+        std::array<std::array<double, 3>, 3> k = {{{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}}};
+        while (!(k[0] <= k[1] && k[0] <= k[2])) std::rotate(k.begin(), k.begin() + 1, k.end());
+        return k;
+    };
+    std::multiset<std::array<std::array<double, 3>, 3>> scene;
+    for (uint32_t t = 0; t < s.triangleCount(); ++t)
+        if (s.triangleObject[t] != kExcludedTriangle) {
+            const uint32_t *ix = &s.indices[3 * t];
+            scene.insert(key(s.positions[ix[0]], s.positions[ix[1]], s.positions[ix[2]]));
+        }
+    uint64_t agree = 0, disagree = 0, found = 0, polygonTris = 0, drawnTris = 0, patchAgree = 0, patchDisagree = 0;
+    double worstSliver = 0;  // |cross| / longest edge^2 of the disagreeing triangles (0.43 for equilateral)
+    for (size_t i = 0; i < nFaces; ++i) {
+        const size_t r = faces + 104 * i;
+        const int32_t type = get32(f, r + 8), v0 = get32(f, r + 12), m0 = get32(f, r + 20), nm = get32(f, r + 24);
+        if (type == 2) {
+            // Patches: the surface's du x dv at each 3x3 block's center (the orientation the loader's
+            // reversed grid triangles have) against the control points' stored normals.
+            const int32_t w = get32(f, r + 96), h = get32(f, r + 100);
+            for (int32_t py = 0; py + 2 < h; py += 2)
+                for (int32_t px = 0; px + 2 < w; px += 2) {
+                    auto P = [&](int i2, int j2) { return pos(v0 + (py + i2) * w + px + j2); };
+                    const Vec3 du = (P(1, 2) - P(1, 0)), dv = (P(2, 1) - P(0, 1));
+                    Vec3 n{0, 0, 0};
+                    for (int a = 0; a < 3; ++a)
+                        for (int b = 0; b < 3; ++b) n = n + nrm(v0 + (py + a) * w + px + b);
+                    const double d = dot(cross(du, dv), n);
+                    if (d > 0) ++patchAgree;
+                    else if (d < 0) ++patchDisagree;
+                }
+            continue;
+        }
+        if (type != 1) continue;
+        // Drawn, by docs/quake3.md's rule: not sky, nodraw/hint/skip, liquid, fog or non-solid translucent.
+        const size_t sh = lumpOffset(f, LShaders) + 72 * size_t(get32(f, r));
+        const uint32_t flags = uint32_t(get32(f, sh + 64)), contents = uint32_t(get32(f, sh + 68));
+        const bool drawn = !(flags & 0x384) && !(contents & 0x78) && !((flags & 0x4000) && (contents & 0x20000000));
+        const Vec3 faceNormal{fl(r + 84), fl(r + 88), fl(r + 92)};
+        for (int32_t k = 0; k < nm; k += 3) {
+            const Vec3 a = pos(v0 + get32(f, mv + 4 * size_t(m0 + k))), b = pos(v0 + get32(f, mv + 4 * size_t(m0 + k + 1))),
+                       c = pos(v0 + get32(f, mv + 4 * size_t(m0 + k + 2)));
+            const Vec3 n = cross(c - a, b - a);  // reversed: a, c, b
+            const double d = dot(n, faceNormal);
+            if (d > 0) ++agree;
+            if (d < 0) {
+                // The few that disagree are slivers (q3map's triangulations leave near-collinear
+                // triangles whose float corners flip them): area tiny next to the longest edge.
+                ++disagree;
+                const double e = std::max({dot(b - a, b - a), dot(c - a, c - a), dot(c - b, c - b)});
+                worstSliver = std::max(worstSliver, length(n) / e);
+            }
+            ++polygonTris;
+            if (drawn && !(n == Vec3{0, 0, 0})) {
+                ++drawnTris;
+                found += scene.count(key(a, c, b)) > 0;
+            }
+        }
+    }
+    std::printf("  polygon triangles %llu: reversed winding agrees with the face normal %llu, disagrees %llu "
+                "(worst sliver %.3g); drawn %llu, found reversed in the scene %llu; patch blocks agree %llu, "
+                "disagree %llu\n",
+                (unsigned long long)polygonTris, (unsigned long long)agree, (unsigned long long)disagree, worstSliver,
+                (unsigned long long)drawnTris, (unsigned long long)found, (unsigned long long)patchAgree,
+                (unsigned long long)patchDisagree);
+    EXPECT_EQ(polygonTris, 29519u);
+    EXPECT_EQ(agree, 29189u);
+    EXPECT_EQ(disagree, 126u);
+    EXPECT_LT(worstSliver, 0.01);
+    EXPECT_EQ(patchAgree, 360u);
+    EXPECT_EQ(patchDisagree, 0u);
+    // Every drawn, non-degenerate polygon triangle is in the scene, reversed.
+    EXPECT_EQ(found, drawnTris);
+    EXPECT_GT(drawnTris, 26000u);
+}
+
+// The cells stage on a real map: from every spawn point the camera is inside a cluster, some
+// objects are culled, and no object visible from the camera's cluster is culled.
+TEST(Cells, RealQ3dm6ishFromSpawnPoints) {
+    REQUIRE_OA("pak1-maps.pk3");
+    const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/q3dm6ish.bsp");
+    ASSERT_EQ(cellsSkipReason(s), nullptr);
+    const BspLevel &lv = *s.bsp;
+    ASSERT_GT(s.views.size(), 0u);
+    for (const ViewSpec &v : s.views) {
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(v.camera, &cam, &err)) << err;
+        const CellsResult r = cullCells(s, cam);
+        EXPECT_FALSE(r.stats.cameraInVoid) << v.name;
+        EXPECT_GT(r.stats.objectsCulled, 0u) << v.name;
+        EXPECT_LT(r.stats.clustersVisible, r.stats.clustersTotal) << v.name;
+        EXPECT_EQ(r.visible.size() + r.stats.objectsCulled, s.objects.size());
+        // Independent check: an object is kept iff one of its clusters is visible (or it has none).
+        std::set<uint32_t> kept(r.visible.begin(), r.visible.end());
+        for (uint32_t o = 0; o < s.objects.size(); ++o) {
+            const uint32_t src = s.objects[o].source;
+            bool want = lv.sourceClustersBegin[src] == lv.sourceClustersBegin[src + 1];
+            for (uint32_t k = lv.sourceClustersBegin[src]; k < lv.sourceClustersBegin[src + 1]; ++k)
+                want |= lv.clusterVisible(r.stats.cameraCluster, lv.sourceClusters[k]);
+            ASSERT_EQ(kept.count(o) > 0, want) << v.name << " object " << s.objects[o].name;
+        }
+    }
+    // Far outside the map: the void; nothing culled.
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(quakeCamera(s, s.bounds.hi + Vec3{1000, 1000, 1000}, 0), &cam, &err)) << err;
+    const CellsResult r = cullCells(s, cam);
+    EXPECT_TRUE(r.stats.cameraInVoid);
+    EXPECT_EQ(r.stats.objectsCulled, 0u);
+    EXPECT_EQ(r.visible.size(), s.objects.size());
+}
+
+TEST(LevelViews, RealWalkViewsInsideClusters) {
+    REQUIRE_OA("pak6-patch088.pk3");
+    const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
+    const std::vector<ViewSpec> v = walkViews(s, 32, 5);
+    ASSERT_EQ(v.size(), 32u);
+    for (const ViewSpec &w : v) {
+        const int32_t leaf = s.bsp->leafAt(w.camera.eye);
+        ASSERT_GE(leaf, 0);
+        EXPECT_GE(s.bsp->leafs[size_t(leaf)].cluster, 0) << w.name;
+    }
+    const std::vector<ViewSpec> again = walkViews(s, 32, 5);
+    for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i].camera.eye, again[i].camera.eye);
+}
