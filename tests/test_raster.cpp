@@ -831,7 +831,9 @@ TEST(RasterCore, FragmentsMatchBruteForce) {
             }
             EXPECT_EQ(sink.begun[t], sink.ended[t]);
             EXPECT_LE(sink.begun[t], 1);
-            if (!want.empty()) EXPECT_EQ(sink.begun[t], 1);
+            if (!want.empty()) {
+                EXPECT_EQ(sink.begun[t], 1);
+            }
             EXPECT_EQ(sink.endCount[t], want.size());
             total += want.size();
         }
