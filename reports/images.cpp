@@ -117,6 +117,18 @@ void fillRect(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, 
 
 }  // namespace
 
+bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err) {
+    return writeImageAtomic(path, "png", ImageSpec(width, height, 3, TypeDesc::UINT8), rgb, err);
+}
+
+bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
+                    std::string *err) {
+    ImageSpec spec(width, height, 1, TypeDesc::UINT32);
+    spec.channelnames = {channel};
+    spec.attribute("compression", "zip");
+    return writeImageAtomic(path, "openexr", spec, values, err);
+}
+
 // ---- Color mappings ---------------------------------------------------------------------------
 
 // Depth complexity ramp: a fixed piecewise-linear ramp through blue, cyan, green, yellow, red and

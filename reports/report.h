@@ -83,6 +83,11 @@ uint8_t depthGray(double d, double dMin, double dMax);
 // ---- Files and folders -----------------------------------------------------------------------
 // Writes a text file atomically (temporary name in the same folder, then rename).
 bool writeFileAtomic(const std::string &path, const std::string &contents, std::string *err);
+// Images written the same way (OpenImageIO, temporary name in the same folder, then rename), for
+// the other image writers of reports/: an interleaved RGB8 PNG, and a one-channel UINT32 EXR (ids).
+bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err);
+bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
+                    std::string *err);
 
 // An output directory written as a whole or not at all: files go into a staging folder next to
 // the target, and commit() swaps it in. An existing target is replaced only if it is a visaudit
