@@ -138,6 +138,7 @@ struct GltfLoader {
     std::vector<uint32_t> materialIndex;  // glTF material -> our material
     std::set<std::string> viewNames;
     uint64_t skippedPrimitives = 0;       // POINTS / LINES primitives
+    uint64_t spotLights = 0;              // KHR_lights_punctual spot lights, read as point lights
 
     std::string nodeName(int i) const {
         const auto &n = model.nodes[size_t(i)];
@@ -324,6 +325,47 @@ struct GltfLoader {
         return true;
     }
 
+    // KHR_lights_punctual: a node's light, placed by the node's world transform. A light shines down
+    // its node's -Z (directional and spot); a point light sits at the node's origin. visaudit's lights
+    // are directional or point: a spot light becomes a point light (its cone is ignored: it could only
+    // make fewer points lit, never more), counted in a warning. Color, intensity and range are ignored
+    // (shadow visibility does not depend on them; a finite range is noted in the docs).
+    bool addLight(int nodeIdx, const Mat4 &world) {
+        const auto &n = model.nodes[size_t(nodeIdx)];
+        auto ext = n.extensions.find("KHR_lights_punctual");
+        if (ext == n.extensions.end() || !ext->second.Has("light")) return true;
+        const auto &lv = ext->second.Get("light");
+        const int li = lv.IsNumber() || lv.IsInt() ? lv.GetNumberAsInt() : -1;
+        if (li < 0 || size_t(li) >= model.lights.size()) {
+            err = path + ": node '" + nodeName(nodeIdx) + "' refers to light " + std::to_string(li) +
+                  ", which does not exist (KHR_lights_punctual.lights has " + std::to_string(model.lights.size()) + ")";
+            return false;
+        }
+        const auto &gl = model.lights[size_t(li)];
+        Light l;
+        l.name = !gl.name.empty() ? gl.name : "light" + std::to_string(li);
+        if (gl.type == "directional") {
+            l.directional = true;
+            const Vec3 d = transformVector(world, {0, 0, -1});
+            if (!(length(d) > 0) || !isFinite(d)) {
+                err = path + ": node '" + nodeName(nodeIdx) + "': directional light '" + l.name +
+                      "' has a degenerate transform (its -Z axis maps to a zero or non-finite direction)";
+                return false;
+            }
+            l.direction = normalize(d);
+        } else if (gl.type == "point" || gl.type == "spot") {
+            l.directional = false;
+            l.position = transformPoint(world, {0, 0, 0});
+            spotLights += gl.type == "spot";
+        } else {
+            err = path + ": light " + std::to_string(li) + " ('" + l.name + "') has unknown type '" + gl.type +
+                  "'; KHR_lights_punctual defines directional, point and spot";
+            return false;
+        }
+        out->lights.push_back(l);
+        return true;
+    }
+
     // Depth-first over the node hierarchy in file order; world = parent * local.
     bool visit(int nodeIdx, const Mat4 &parent, std::vector<char> &onPath) {
         if (nodeIdx < 0 || size_t(nodeIdx) >= model.nodes.size()) {
@@ -350,6 +392,7 @@ struct GltfLoader {
             }
         }
         if (n.camera >= 0 && !addCamera(nodeIdx, world)) return false;
+        if (!addLight(nodeIdx, world)) return false;
         for (int c : n.children)
             if (!visit(c, world, onPath)) return false;
         onPath[size_t(nodeIdx)] = 0;
@@ -377,6 +420,9 @@ struct GltfLoader {
         if (skippedPrimitives)
             out->warnings.push_back(path + ": " + std::to_string(skippedPrimitives) +
                                     " point/line primitive(s) skipped (they have no area)");
+        if (spotLights)
+            out->warnings.push_back(path + ": " + std::to_string(spotLights) +
+                                    " KHR_lights_punctual spot light(s) read as point light(s) (the cone is ignored)");
         return true;
     }
 };
@@ -418,7 +464,7 @@ bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err) {
     in.path = path;
     in.up = 'y';  // glTF is y-up
     if (!gwarn.empty()) in.warnings.push_back(path + ": tinygltf: " + oneLine(gwarn));
-    GltfLoader loader{path, model, &in, {}, {}, {}, 0};
+    GltfLoader loader{path, model, &in, {}, {}, {}, 0, 0};
     if (!loader.run()) return fail(loader.err);
     *out = std::move(in);
     return true;
