@@ -22,6 +22,7 @@
 #include "render/clip.h"
 #include "render/raster.h"
 #include "render/raycast.h"
+#include "reports/audit_images.h"
 
 namespace va {
 namespace {
@@ -321,6 +322,37 @@ TEST(AuditBroken, FrustumPushedInwardsIsCaughtExactly) {
         }
     EXPECT_GT(cb.genuine, a.stages[0].falseCullPixels * 9 / 10);
     EXPECT_LE(cb.genuine, a.stages[0].falseCullPixels);
+
+    // The images, read back: the culling image shows exactly the false-cull pixels in stage 0's
+    // color above its legend; the diff image the genuine pixels in red; the ids round-trip.
+    const std::string dir = ::testing::TempDir() + "/audit_images";
+    std::filesystem::create_directories(dir);
+    const AuditImageNames files = auditImageNames(dir + "/boxes");
+    ASSERT_TRUE(writeCullingImage(ref, a, files.cullingPng, &err)) << err;
+    ASSERT_TRUE(writeRaycastDiffImage(broken.z.buffer, cb, files.raycastDiffPng, &err)) << err;
+    ASSERT_TRUE(writeRaycastIds(cam.width, cam.height, img.id, files.raycastIdsExr, &err)) << err;
+    auto countColor = [&](const ImageData &im, Rgb8 c) {
+        uint64_t k = 0;
+        for (int y = 0; y < cam.height; ++y)  // the image area, above the legend
+            for (int x = 0; x < cam.width; ++x) {
+                const uint8_t *p = &im.u8[(size_t(y) * im.width + x) * 3];
+                k += p[0] == c.r && p[1] == c.g && p[2] == c.b;
+            }
+        return k;
+    };
+    ImageData culling, diff, ids;
+    ASSERT_TRUE(readImage(files.cullingPng, &culling, &err)) << err;
+    EXPECT_EQ(culling.width, cam.width);
+    EXPECT_GT(culling.height, cam.height);  // the legend strip
+    EXPECT_EQ(countColor(culling, cullStageColor(0)), a.stages[0].falseCullPixels);
+    ASSERT_TRUE(readImage(files.raycastDiffPng, &diff, &err)) << err;
+    EXPECT_EQ(countColor(diff, disagreementColor(Disagreement::genuine)), cb.genuine);
+    EXPECT_EQ(countColor(diff, disagreementColor(Disagreement::edge)), cb.edge);
+    ASSERT_TRUE(readImage(files.raycastIdsExr, &ids, &err)) << err;
+    EXPECT_EQ(ids.pixelType, "uint");
+    EXPECT_EQ(ids.u32, img.id);
+    for (const auto &e : std::filesystem::directory_iterator(dir))
+        EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << "temporary file left: " << e.path();
 }
 
 // ---- Reference details ------------------------------------------------------------------------

@@ -1,0 +1,173 @@
+// Images of the audits (audit_images.h).
+#include "reports/audit_images.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "reports/font.h"
+
+namespace va {
+
+namespace {
+
+constexpr Rgb8 kStrip{24, 24, 24};
+constexpr Rgb8 kText{255, 255, 255};
+
+void put(std::vector<uint8_t> &rgb, int w, int x, int y, Rgb8 c) {
+    uint8_t *p = &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3];
+    p[0] = c.r;
+    p[1] = c.g;
+    p[2] = c.b;
+}
+void fill(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c) {
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) put(rgb, w, x, y, c);
+}
+
+// Nearest and farthest finite positive depth (the range of depthGray).
+void depthRange(const std::vector<double> &depth, double *lo, double *hi) {
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (double d : depth)
+        if (std::isfinite(d) && d > 0) {
+            *lo = std::min(*lo, d);
+            *hi = std::max(*hi, d);
+        }
+}
+
+// A legend strip below an image of width W, height H: swatches with their labels in one row,
+// left-aligned, wrapping onto more rows when wider than the canvas. Sizes scale with the font
+// scale s: row height = margin 3s + text 7s (swatch as tall as the text) + margin 3s.
+struct LegendEntry {
+    Rgb8 color;
+    std::string label;
+};
+std::vector<uint8_t> withLegend(const std::vector<uint8_t> &image, int W, int H, const std::vector<LegendEntry> &entries,
+                                int *canvasH) {
+    const int s = W >= 1024 ? 2 : 1;
+    const int margin = 3 * s, rowH = margin + textHeight(s) + margin, swatch = textHeight(s);
+    // Lay out the entries: swatch, gap 2s, label, gap 6s.
+    std::vector<std::pair<int, int>> at;  // (x, row)
+    int x = margin, row = 0;
+    for (const LegendEntry &e : entries) {
+        const int ew = swatch + 2 * s + textWidth(e.label, s);
+        if (x > margin && x + ew > W - margin) {
+            x = margin;
+            ++row;
+        }
+        at.push_back({x, row});
+        x += ew + 6 * s;
+    }
+    const int strip = (row + 1) * rowH;
+    *canvasH = H + strip;
+    std::vector<uint8_t> rgb(size_t(W) * size_t(*canvasH) * 3);
+    std::copy(image.begin(), image.end(), rgb.begin());
+    fill(rgb, W, 0, H, W, *canvasH, kStrip);
+    for (size_t i = 0; i < entries.size(); ++i) {
+        const int ex = at[i].first, ey = H + at[i].second * rowH + margin;
+        fill(rgb, W, ex, ey, std::min(ex + swatch, W), std::min(ey + swatch, *canvasH), entries[i].color);
+        drawText(rgb.data(), W, *canvasH, ex + swatch + 2 * s, ey, entries[i].label, {kText.r, kText.g, kText.b}, s);
+    }
+    return rgb;
+}
+
+}  // namespace
+
+AuditImageNames auditImageNames(const std::string &baseName) {
+    return {baseName + ".culling.png", baseName + ".raycast_diff.png", baseName + ".raycast.ids.exr"};
+}
+
+Rgb8 cullStageColor(size_t stage) {
+    // Saturated, mutually distinct, none gray or magenta (those mean drawn / unaccounted).
+    static constexpr Rgb8 kColors[] = {{255, 48, 32}, {255, 200, 0}, {0, 200, 255}, {64, 220, 64}, {255, 128, 0}, {64, 96, 255}};
+    return kColors[stage % std::size(kColors)];
+}
+
+Rgb8 disagreementColor(Disagreement d) {
+    switch (d) {
+    case Disagreement::edge: return {64, 128, 255};
+    case Disagreement::tie: return {255, 220, 0};
+    case Disagreement::genuine: return {255, 0, 0};
+    case Disagreement::none: break;
+    }
+    return {0, 0, 0};
+}
+
+bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, const std::string &path, std::string *err) {
+    const int W = ref.width, H = ref.height;
+    const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
+    if (W <= 0 || H <= 0 || ref.id.size() != n || audit.fate.size() != n) {
+        if (err) *err = "cannot write image '" + path + "': the reference and the culling audit have no matching " +
+                        std::to_string(W) + "x" + std::to_string(H) + " buffers";
+        return false;
+    }
+    double lo, hi;
+    depthRange(ref.depth, &lo, &hi);
+    std::vector<uint8_t> img(n * 3);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const size_t i = size_t(y) * size_t(W) + size_t(x);
+            const uint8_t f = audit.fate[i];
+            Rgb8 c{0, 0, 0};
+            if (f == kFateDrawn) {
+                const uint8_t g = depthGray(ref.depth[i], lo, hi);
+                c = {uint8_t(g * kCullDrawnTint.r / 255), uint8_t(g * kCullDrawnTint.g / 255),
+                     uint8_t(g * kCullDrawnTint.b / 255)};
+            } else if (f == kFateUnaccounted) {
+                c = kCullUnaccounted;
+            } else if (f >= kFateCulledFirst) {
+                c = cullStageColor(f - kFateCulledFirst);
+            }
+            put(img, W, x, y, c);
+        }
+    std::vector<LegendEntry> legend = {{{200, 200, 200}, "drawn"}};
+    for (size_t k = 0; k < audit.stages.size(); ++k)
+        legend.push_back({cullStageColor(k), "false cull: " + audit.stages[k].stage + " (" +
+                                                 std::to_string(audit.stages[k].falseCullPixels) + " px)"});
+    if (audit.unaccountedPixels) legend.push_back({kCullUnaccounted, "unaccounted"});
+    int CH = 0;
+    const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);
+    return writePngRgb8(path, W, CH, rgb.data(), err);
+}
+
+bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err) {
+    const int W = zb.width, H = zb.height;
+    const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
+    if (W <= 0 || H <= 0 || zb.depth.size() != n || check.cls.size() != n) {
+        if (err) *err = "cannot write image '" + path + "': the z-buffer and the cross-check have no matching " +
+                        std::to_string(W) + "x" + std::to_string(H) + " buffers";
+        return false;
+    }
+    double lo, hi;
+    depthRange(zb.depth, &lo, &hi);
+    std::vector<uint8_t> img(n * 3);
+    for (size_t i = 0; i < n; ++i) {
+        const Disagreement d = Disagreement(check.cls[i]);
+        Rgb8 c;
+        if (d == Disagreement::none) {
+            const uint8_t g = uint8_t(depthGray(zb.depth[i], lo, hi) / 4);  // dimmed: the classes stand out
+            c = {g, g, g};
+        } else {
+            c = disagreementColor(d);
+        }
+        put(img, W, int(i % size_t(W)), int(i / size_t(W)), c);
+    }
+    const std::vector<LegendEntry> legend = {
+        {disagreementColor(Disagreement::edge), "edge " + std::to_string(check.edge)},
+        {disagreementColor(Disagreement::tie), "tie " + std::to_string(check.tie)},
+        {disagreementColor(Disagreement::genuine), "genuine " + std::to_string(check.genuine)}};
+    int CH = 0;
+    const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);
+    return writePngRgb8(path, W, CH, rgb.data(), err);
+}
+
+bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err) {
+    if (width <= 0 || height <= 0 || ids.size() != size_t(width) * size_t(height)) {
+        if (err) *err = "cannot write image '" + path + "': no " + std::to_string(width) + "x" + std::to_string(height) +
+                        " ray-cast ids";
+        return false;
+    }
+    return writeExrUint32(path, width, height, ids.data(), "id", err);
+}
+
+}  // namespace va
