@@ -162,6 +162,17 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         st.trianglesOut = z.stats.trianglesDrawn;
         r.stages.push_back(st);
     }
+
+    // Audit: z-fighting of the two nearest surfaces per pixel, in every depth format, over exactly
+    // the triangles the z-buffer drew.
+    if (s.zfight) {
+        const auto t0 = Clock::now();
+        r.zfight = analyzeZFighting(scene, cam, clip.out, s.zfightSettings);
+        r.zfightMs = msSince(t0);
+        r.zfightRan = true;
+    } else {
+        r.zfightReason = "turned off by --no-zfight";
+    }
     r.totalMs = msSince(tView);
     return r;
 }

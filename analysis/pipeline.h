@@ -10,6 +10,7 @@
 #include "analysis/frustum.h"
 #include "analysis/results.h"
 #include "analysis/scene.h"
+#include "analysis/zfight.h"
 #include "render/clip.h"
 
 namespace va {
@@ -25,6 +26,8 @@ struct PipelineSettings {
     int width = 0, height = 0;                 // > 0: override every view's resolution
     std::optional<DepthFormat> depthFormat;    // override every view's depth format
     ClipSettings clip;
+    bool zfight = true;    // --no-zfight turns the z-fighting analysis off
+    ZFightSettings zfightSettings;
     Limits limits;
     int threads = 0;                           // 0: all cores
 };

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "analysis/scene.h"
+#include "analysis/zfight.h"
 #include "render/clip.h"
 #include "render/raster.h"
 
@@ -52,6 +53,10 @@ struct ViewResult {
     ClipStats clip;
     ZBufferStats zbuffer;
     ZBuffer buffer;                   // per-pixel buffers, for the images (may be released after writing)
+    bool zfightRan = false;           // the per-view z-fighting analysis (docs/zfighting.md)
+    std::string zfightReason;         // why it did not run
+    ZFightResult zfight;
+    double zfightMs = 0;
     double totalMs = 0;
 };
 

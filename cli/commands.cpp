@@ -44,7 +44,8 @@ struct Options {
     int threads = 0;
     int maxResolution = 16384;
     uint32_t chunk = 512;
-    bool noBackface = false, noFrustum = false;
+    bool noBackface = false, noFrustum = false, noZFight = false;
+    uint64_t zfightMinArea = 1;
     bool quiet = false;
     bool json = false;  // --json: the summary on stdout
     // depth-audit
@@ -100,6 +101,8 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
 bool makeSettings(const Options &o, PipelineSettings *s) {
     s->frustum = !o.noFrustum;
     s->backface = !o.noBackface;
+    s->zfight = !o.noZFight;
+    s->zfightSettings.minHotspotArea = o.zfightMinArea;
     s->width = o.width;
     s->height = o.height;
     s->threads = o.threads;
@@ -205,6 +208,9 @@ int analyzeToReport(const Options &o,
         v.imageBase = bases[i];
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
         v.buffer = ZBuffer{};  // the images hold it now
+        v.zfight.pixelClass = {};
+        v.zfight.fightMask = {};
+        v.zfight.hotspotOf = {};
         const int k = ++done;
         if (!o.quiet) {
             // A terminal gets one line rewritten in place with an estimate of the time left; a log
@@ -468,6 +474,9 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
         ->check(CLI::Range(1, 1 << 20));
     c->add_flag("--no-backface", o.noBackface, "Turn the backface stage off");
     c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
+    c->add_flag("--no-zfight", o.noZFight, "Turn the z-fighting analysis off");
+    c->add_option("--zfight-min-area", o.zfightMinArea, "Smallest hotspot, in pixels (smaller clusters still count as fighting pixels)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
     c->add_flag("--json", o.json, "Print the summary as JSON on stdout (for piping); progress stays on stderr");
     c->add_option("--shard", o.shard, "Analyse only shard K of N: the views whose index i has i % N == K - 1 "

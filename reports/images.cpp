@@ -23,6 +23,7 @@
 
 #include "reports/font.h"
 #include "reports/report.h"
+#include "reports/zfight_image.h"
 
 namespace va {
 
@@ -254,6 +255,9 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
         spec.attribute("compression", "zip");
         if (!writeImageAtomic(prefix + names.idsExr, "openexr", spec, zb.id.data(), err)) return false;
     }
+
+    // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
+    if (view.zfightRan && !writeZFightImage(view.zfight, zb, prefix + names.zfightPng, err)) return false;
     return true;
 }
 

@@ -40,6 +40,7 @@ struct ViewImageNames {
     std::string depthPng;     // BASE.depth.png
     std::string overdrawPng;  // BASE.overdraw.png
     std::string idsExr;       // BASE.ids.exr
+    std::string zfightPng;    // BASE.zfight.png (when the z-fighting analysis ran)
 };
 ViewImageNames viewImageNames(const std::string &baseName);
 

@@ -67,7 +67,8 @@ std::vector<std::string> imageBaseNames(const std::vector<ViewSpec> &views) {
 }
 
 ViewImageNames viewImageNames(const std::string &baseName) {
-    return {baseName + ".depth.exr", baseName + ".depth.png", baseName + ".overdraw.png", baseName + ".ids.exr"};
+    return {baseName + ".depth.exr", baseName + ".depth.png", baseName + ".overdraw.png", baseName + ".ids.exr",
+            baseName + ".zfight.png"};
 }
 
 // ---- JSON -------------------------------------------------------------------------------------
@@ -165,6 +166,55 @@ Json cameraJson(const CameraSpec &c) {
     return j;
 }
 
+// The per-view z-fighting analysis (analysis/zfight.h; docs/zfighting.md).
+Json depthJson(const ZFightResult &z, double ms) {
+    Json j;
+    j["ran"] = true;
+    j["covered_pixels"] = z.coveredPixels;
+    j["two_surface_pixels"] = z.twoSurfacePixels;
+    j["fighting_pixels_any_format"] = z.fightingPixelsAnyFormat;
+    j["classes"] = {{"separated", z.separatedPixels},
+                    {"coplanar", z.coplanarPixels},
+                    {"shared_edge", z.sharedEdgePixels},
+                    {"intersection", z.intersectionPixels}};
+    Json formats = Json::object();
+    for (const ZFightFormatStats &f : z.perFormat) {
+        formats[f.name] = {{"bits", f.bits},
+                           {"fighting_pixels", f.fightingPixels},
+                           {"coplanar_pixels", f.coplanarPixels},
+                           {"shared_edge_pixels", f.sharedEdgePixels},
+                           {"intersection_pixels", f.intersectionPixels},
+                           {"hotspots", f.hotspots},
+                           {"out_of_range_pixels", f.outOfRangePixels}};
+    }
+    j["formats"] = formats;
+    j["recommended_format"] = z.recommended ? Json(depthFormatInfo(*z.recommended).name) : Json(nullptr);
+    j["recommendation"] = z.recommendation;
+    j["hotspot_count"] = z.hotspotCount;
+    Json hs = Json::array();
+    for (const ZFightHotspot &h : z.hotspots) {
+        Json fj = Json::array();
+        for (const ZFightHotspotFormat &f : h.formats)
+            fj.push_back({{"name", depthFormatInfo(f.format).name}, {"pixels", f.pixels}});
+        hs.push_back({{"id", h.id},
+                      {"area", h.area},
+                      {"bbox", {h.minX, h.minY, h.maxX, h.maxY}},
+                      {"centroid", vec3(h.centroid)},
+                      {"depth", num(h.depth)},
+                      {"depth_gap", num(h.depthGap)},
+                      {"depth_gap_max", num(h.depthGapMax)},
+                      {"coplanar_pixels", h.coplanarPixels},
+                      {"objects", {h.objectA, h.objectB}},
+                      {"triangles", {h.triangleA, h.triangleB}},
+                      {"pair_pixels", h.pairPixels},
+                      {"pairs", h.pairs},
+                      {"formats", fj}});
+    }
+    j["hotspots"] = hs;
+    j["ms"] = num(ms);
+    return j;
+}
+
 Json zbufferJson(const ZBufferStats &z) {
     Json j;
     j["covered_pixels"] = z.coveredPixels;
@@ -220,10 +270,15 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
         vj["stages"] = stages;
         vj["zbuffer"] = zbufferJson(v.zbuffer);
         const ViewImageNames names = viewImageNames(v.imageBase.empty() ? bases[i] : v.imageBase);
+        if (v.zfightRan)
+            vj["depth"] = depthJson(v.zfight, v.zfightMs);
+        else
+            vj["depth"] = {{"ran", false}, {"reason", v.zfightReason}};
         vj["images"] = {{"depth_exr", names.depthExr},
                         {"depth_png", names.depthPng},
                         {"overdraw_png", names.overdrawPng},
                         {"ids_exr", names.idsExr}};
+        if (v.zfightRan) vj["images"]["zfight_png"] = names.zfightPng;
         vj["total_ms"] = num(v.totalMs);
         views.push_back(vj);
     }
