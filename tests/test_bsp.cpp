@@ -986,3 +986,39 @@ TEST(LevelViews, RealWalkViewsInsideClusters) {
     const std::vector<ViewSpec> again = walkViews(s, 32, 5);
     for (size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i].camera.eye, again[i].camera.eye);
 }
+
+// Exact cells numbers from the first spawn point of each real map (docs/quake3.md quotes them).
+TEST(Cells, RealMapsFirstSpawnExactCounts) {
+    REQUIRE_OA("pak6-patch088.pk3");
+    REQUIRE_OA("pak1-maps.pk3");
+    struct Want {
+        std::string path;
+        int32_t leaf, cluster;
+        uint64_t clustersVisible, clustersTotal, objectsCulled, objectsIn, trianglesCulled, trianglesIn;
+    };
+    for (const Want &w : std::vector<Want>{
+             {"pak1-maps.pk3:maps/q3dm6ish.bsp", 238, 97, 176, 247, 53, 231, 404, 2621},
+             {"pak1-maps.pk3:maps/oa_dm1.bsp", 327, 120, 90, 422, 151, 241, 3215, 7422},
+             {"pak6-patch088.pk3:maps/oa_thor.bsp", 4828, 2539, 1191, 2825, 1166, 2297, 18980, 42980}}) {
+        const Scene s = loadReal(kOa + w.path);
+        ASSERT_GT(s.views.size(), 0u);
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(s.views[0].camera, &cam, &err)) << err;
+        const CellsResult r = cullCells(s, cam);
+        const CellsStats &c = r.stats;
+        std::printf("  %s %s: leaf %d cluster %d, clusters %llu / %llu, objects culled %llu / %llu, triangles culled "
+                    "%llu / %llu\n", w.path.c_str(), s.views[0].name.c_str(), c.cameraLeaf, c.cameraCluster,
+                    (unsigned long long)c.clustersVisible, (unsigned long long)c.clustersTotal,
+                    (unsigned long long)c.objectsCulled, (unsigned long long)c.objectsIn,
+                    (unsigned long long)c.trianglesCulled, (unsigned long long)c.trianglesIn);
+        EXPECT_EQ(c.cameraLeaf, w.leaf) << w.path;
+        EXPECT_EQ(c.cameraCluster, w.cluster) << w.path;
+        EXPECT_EQ(c.clustersVisible, w.clustersVisible) << w.path;
+        EXPECT_EQ(c.clustersTotal, w.clustersTotal) << w.path;
+        EXPECT_EQ(c.objectsCulled, w.objectsCulled) << w.path;
+        EXPECT_EQ(c.objectsIn, w.objectsIn) << w.path;
+        EXPECT_EQ(c.trianglesCulled, w.trianglesCulled) << w.path;
+        EXPECT_EQ(c.trianglesIn, w.trianglesIn) << w.path;
+    }
+}
