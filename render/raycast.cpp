@@ -159,20 +159,51 @@ void fillPacket(const RayGen &gen, const Camera &cam, int tx, int ty, RTCRayHit1
 }  // namespace
 
 namespace {
-// castPrimary's back-face rejection: an intersect context extended with a per-primitive table
-// (Embree passes the context it was given to the filter, so the cast is safe).
-struct RejectContext {
+// castPrimary's options as an Embree context filter: an intersect context extended with what the
+// filter needs (Embree passes the context it was given to the filter, so the cast is safe).
+//  - Back-face rejection: a per-primitive table.
+//  - Ties to the lowest id: Embree accepts a candidate hit when t <= the current tfar, so of two hits
+//    at a bit-identical t (a ray exactly through a shared edge, coplanar overlap) the one found last
+//    wins, and the order depends on the traversal (packet and single-ray kernels differ). Before the
+//    filter runs Embree sets the ray's tfar to the candidate's t; the filter keeps, per packet lane
+//    (the ray id), the t and source id it last accepted, and rejects a candidate at the same t with a
+//    higher source id. Candidates farther than the accepted hit never reach the filter.
+struct FilterContext {
     RTCIntersectContext ctx;
-    const uint8_t *reject = nullptr;  // per Embree primitive: 1 = hits on it are rejected
+    const uint8_t *reject = nullptr;             // per Embree primitive: 1 = hits on it are rejected
+    const uint32_t *primToSource = nullptr;      // non-null: break ties to the lowest source id
+    float bestT[16];
+    uint32_t bestSource[16];
+    void resetLanes() {
+        for (int i = 0; i < 16; ++i) bestT[i] = INFINITY, bestSource[i] = 0xFFFFFFFFu;
+    }
 };
-void rejectFilter(const RTCFilterFunctionNArguments *args) {
-    const uint8_t *reject = reinterpret_cast<const RejectContext *>(args->context)->reject;
-    for (unsigned i = 0; i < args->N; ++i)
-        if (args->valid[i] == -1 && reject[RTCHitN_primID(args->hit, args->N, i)]) args->valid[i] = 0;
+void primaryFilter(const RTCFilterFunctionNArguments *args) {
+    FilterContext &fc = *reinterpret_cast<FilterContext *>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        if (fc.reject && fc.reject[prim]) {
+            args->valid[i] = 0;
+            continue;
+        }
+        if (fc.primToSource) {
+            const unsigned lane = RTCRayN_id(args->ray, args->N, i) & 15u;
+            const float t = RTCRayN_tfar(args->ray, args->N, i);
+            const uint32_t src = fc.primToSource[prim];
+            if (t == fc.bestT[lane] && src > fc.bestSource[lane]) {
+                args->valid[i] = 0;
+                continue;
+            }
+            fc.bestT[lane] = t;
+            fc.bestSource[lane] = src;
+        }
+    }
 }
 
 // The tile loop shared by both castPrimary overloads (kBary: also write barycentrics).
-template <bool kBary>
+// kTies: ctx is a FilterContext that tracks ties per lane (reset per packet).
+template <bool kBary, bool kTies>
 void castTiles(RTCScene scene, RTCIntersectContext *ctx, const RayGen &gen, const Camera &cam,
                const std::vector<uint32_t> &primToSource, RaycastImage &img, RaycastStats &st) {
     alignas(64) RTCRayHit16 rh;
@@ -180,6 +211,7 @@ void castTiles(RTCScene scene, RTCIntersectContext *ctx, const RayGen &gen, cons
     for (int ty = 0; ty < cam.height; ty += 4)
         for (int tx = 0; tx < cam.width; tx += 4) {
             fillPacket(gen, cam, tx, ty, rh, valid);
+            if constexpr (kTies) reinterpret_cast<FilterContext *>(ctx)->resetLanes();
             rtcIntersect16(valid, scene, ctx, &rh);
             ++st.packets;
             for (int i = 0; i < 16; ++i) {
@@ -211,7 +243,7 @@ RaycastImage RayScene::castPrimary(const Camera &cam, RaycastStats *stats) const
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     RaycastStats st;
-    castTiles<false>(m.scene, &ctx, gen, cam, m.primToSource, img, st);
+    castTiles<false, false>(m.scene, &ctx, gen, cam, m.primToSource, img, st);
     if (stats) *stats = st;
     return img;
 }
@@ -229,7 +261,7 @@ RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt,
         img.v.assign(n, 0.0f);
     }
     const RayGen gen(cam, m.origin);
-    RejectContext rc;
+    FilterContext rc;
     rtcInitIntersectContext(&rc.ctx);
     rc.ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     std::vector<uint8_t> reject;
@@ -260,13 +292,20 @@ RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt,
             reject[k] = front ? 0 : 1;
         }
         rc.reject = reject.data();
-        rc.ctx.filter = rejectFilter;
+        rc.ctx.filter = primaryFilter;
+    }
+    if (opt.tiesToLowestId && !m.primToSource.empty()) {
+        rc.primToSource = m.primToSource.data();
+        rc.ctx.filter = primaryFilter;
     }
     RaycastStats st;
+    const bool ties = rc.primToSource != nullptr;
     if (opt.keepBarycentrics)
-        castTiles<true>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
+        ties ? castTiles<true, true>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st)
+             : castTiles<true, false>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
     else
-        castTiles<false>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
+        ties ? castTiles<false, true>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st)
+             : castTiles<false, false>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
     if (stats) *stats = st;
     return img;
 }

@@ -52,6 +52,11 @@ struct PrimaryOptions {
     // Scene::planes, so the facing decision is the backface stage's own (in double). Null: computed
     // in double from the float vertices Embree holds.
     const double *planes = nullptr;
+    // Of two hits at a bit-identical distance (a ray exactly through a shared edge, coplanar
+    // triangles) keep the lower source id, as the reference visibility does (DESIGN.md, Ties).
+    // Without it Embree keeps whichever it found last, which depends on the traversal: packet and
+    // single-ray kernels can differ there.
+    bool tiesToLowestId = false;
     // Fill RaycastImage::u and v (render/effects.h needs them).
     bool keepBarycentrics = false;
 };

@@ -372,3 +372,37 @@ TEST(Raycast, EmptySceneMissesEverything) {
     EXPECT_FALSE(rs.occluded(LocalRay{}));
     EXPECT_EQ(rs.primitiveOf(0), kNoHit);
 }
+
+// Ties to the lowest id (PrimaryOptions::tiesToLowestId): two coplanar copies of a quad, triangulated
+// along opposite diagonals, seen by an orthographic camera whose pixel centers lie exactly on both
+// diagonals. Every hit is a bit-identical tie between the copies (and on a diagonal, between the two
+// triangles of a copy): the lowest source id must win at every pixel, for packets of any layout.
+TEST(Raycast, TiesToLowestId) {
+    RawMesh first = gridMesh({-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 1, 1);  // triangles 0 (y <= x), 1 (y >= x)
+    RawMesh second = first;
+    second.indices = {1, 3, 2, 1, 2, 0};  // the same quad along the other diagonal (positions a, b, d, c)
+    for (int order = 0; order < 2; ++order) {
+        const Scene s = sceneOf(order == 0 ? std::vector<RawMesh>{first, second} : std::vector<RawMesh>{second, first});
+        auto rs = rayScene(s);
+        const Camera cam = cameraOf({0, 0, 5}, {0, 0, 0}, 16, 16, true, 2);
+        PrimaryOptions opt;
+        opt.tiesToLowestId = true;
+        const RaycastImage img = rs->castPrimary(cam, opt, nullptr);
+        const RaycastImage plain = rs->castPrimary(cam, nullptr);
+        uint64_t plainDiffers = 0;
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x) {
+                const double X = -1 + (x + 0.5) / 8, Y = 1 - (y + 0.5) / 8;
+                // first: triangle 0 = (a, b, c) covers y <= x, triangle 1 = (a, c, d) covers y >= x;
+                // second: triangle 0 = (b, c, d) covers y >= -x, triangle 1 = (b, d, a) covers y <= -x
+                // (a..d = the quad's corners (-1,-1), (1,-1), (1,1), (-1,1)). On a diagonal: triangle 0.
+                const uint32_t expect = order == 0 ? (Y <= X ? 1 : 2) : (Y >= -X ? 1 : 2);
+                const size_t p = size_t(y) * 16 + x;
+                EXPECT_EQ(img.id[p], expect) << "order " << order << " pixel " << x << "," << y;
+                EXPECT_EQ(img.depth[p], 5.0f);
+                plainDiffers += plain.id[p] != expect;
+            }
+        std::printf("[ info ] order %d: without tiesToLowestId, %llu of 256 pixels name a higher id\n", order,
+                    (unsigned long long)plainDiffers);
+    }
+}
