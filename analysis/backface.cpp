@@ -84,6 +84,7 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
                 if (isFrontFacing(scene, t, cam, &edgeOn)) {
                     l.triangles.push_back(t);
                 } else {
+                    r.culled.push_back(t);
                     ++st.trianglesCulled;
                     st.edgeOn += edgeOn;
                 }

@@ -26,6 +26,7 @@ TriangleLists allTriangles(const Scene &scene, const std::vector<uint32_t> &obje
 
 struct BackfaceResult {
     TriangleLists kept;
+    std::vector<uint32_t> culled;  // the triangles it culled, in submission order (for the audits)
     BackfaceStats stats;
 };
 BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &objects, const Camera &cam);

@@ -73,6 +73,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
 
     // Frustum: bounding spheres over the object BVH.
     std::vector<uint32_t> objects;
+    std::vector<StageCulls> culls;  // what each culling stage removed, for the audit
     const uint64_t sceneTriangles = scene.objectTriangles.size();
     {
         StageRecord st;
@@ -84,6 +85,17 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             st.ran = true;
             objects = std::move(f.visible);
             r.frustum = f.stats;
+            if (s.audit) {
+                StageCulls c{"frustum", {}, {}};
+                size_t k = 0;
+                for (uint32_t o = 0; o < scene.objects.size(); ++o) {
+                    if (k < objects.size() && objects[k] == o)
+                        ++k;
+                    else
+                        c.objects.push_back(o);
+                }
+                culls.push_back(std::move(c));
+            }
             st.trianglesIn = sceneTriangles;
             st.trianglesOut = trianglesOf(scene, objects);
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;
@@ -107,6 +119,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             st.ran = true;
             r.backface = b.stats;
             lists = std::move(b.kept);
+            if (s.audit) culls.push_back({"backface", {}, std::move(b.culled)});
             st.trianglesIn = trianglesOf(scene, objects);
             st.trianglesOut = lists.size();
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;
@@ -145,12 +158,17 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     }
 
     // Z-buffer: rasterize in the view's depth format.
+    std::vector<uint32_t> fragmentsPerSource;  // per source triangle (audit: wasted fragments)
     {
         StageRecord st;
         st.name = "zbuffer";
         ZBufferSettings zs;
         zs.encoder = makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ);
         zs.orthographic = cam.orthographic;
+        if (s.audit) {
+            fragmentsPerSource.assign(scene.triangleCount(), 0);
+            zs.fragmentsPerSource = fragmentsPerSource.data();
+        }
         const auto t0 = Clock::now();
         ZBufferResult z = rasterize(clip.out, cam.width, cam.height, zs);
         st.ms = msSince(t0);
@@ -161,6 +179,18 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         st.trianglesCulled = z.stats.trianglesEmpty;
         st.trianglesOut = z.stats.trianglesDrawn;
         r.stages.push_back(st);
+    }
+
+    // Audit: the reference visibility (no culling at all), and what each culling stage removed
+    // that is in fact visible (false culls) or kept that is visible nowhere (wasted draws).
+    if (s.audit) {
+        const auto t0 = Clock::now();
+        r.reference = referenceVisibility(scene, cam);
+        r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource);
+        r.auditMs = msSince(t0);
+        r.auditRan = true;
+    } else {
+        r.auditReason = "turned off by --no-audit";
     }
 
     // Audit: z-fighting of the two nearest surfaces per pixel, in every depth format, over exactly

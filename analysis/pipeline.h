@@ -27,6 +27,7 @@ struct PipelineSettings {
     std::optional<DepthFormat> depthFormat;    // override every view's depth format
     ClipSettings clip;
     bool zfight = true;    // --no-zfight turns the z-fighting analysis off
+    bool audit = true;     // --no-audit turns the reference-visibility audit off
     ZFightSettings zfightSettings;
     Limits limits;
     int threads = 0;                           // 0: all cores

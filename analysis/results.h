@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/audit.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
 #include "render/clip.h"
@@ -53,6 +54,13 @@ struct ViewResult {
     ClipStats clip;
     ZBufferStats zbuffer;
     ZBuffer buffer;                   // per-pixel buffers, for the images (may be released after writing)
+    // Audit against the reference visibility (docs/audits.md): per-pixel buffers are released once
+    // the images are written.
+    bool auditRan = false;
+    std::string auditReason;          // why it did not run
+    ReferenceVisibility reference;
+    CullAudit cullAudit;
+    double auditMs = 0;
     bool zfightRan = false;           // the per-view z-fighting analysis (docs/zfighting.md)
     std::string zfightReason;         // why it did not run
     ZFightResult zfight;

@@ -44,7 +44,7 @@ struct Options {
     int threads = 0;
     int maxResolution = 16384;
     uint32_t chunk = 512;
-    bool noBackface = false, noFrustum = false, noZFight = false;
+    bool noBackface = false, noFrustum = false, noZFight = false, noAudit = false;
     uint64_t zfightMinArea = 1;
     bool quiet = false;
     bool json = false;  // --json: the summary on stdout
@@ -102,6 +102,7 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->frustum = !o.noFrustum;
     s->backface = !o.noBackface;
     s->zfight = !o.noZFight;
+    s->audit = !o.noAudit;
     s->zfightSettings.minHotspotArea = o.zfightMinArea;
     s->width = o.width;
     s->height = o.height;
@@ -208,6 +209,10 @@ int analyzeToReport(const Options &o,
         v.imageBase = bases[i];
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
         v.buffer = ZBuffer{};  // the images hold it now
+        v.reference.id = {};
+        v.reference.depth = {};
+        v.reference.pixelsOf = {};
+        v.cullAudit.fate = {};
         v.zfight.pixelClass = {};
         v.zfight.fightMask = {};
         v.zfight.hotspotOf = {};
@@ -475,6 +480,7 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-backface", o.noBackface, "Turn the backface stage off");
     c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
     c->add_flag("--no-zfight", o.noZFight, "Turn the z-fighting analysis off");
+    c->add_flag("--no-audit", o.noAudit, "Turn the reference-visibility audit (false culls, wasted draws) off");
     c->add_option("--zfight-min-area", o.zfightMinArea, "Smallest hotspot, in pixels (smaller clusters still count as fighting pixels)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");

@@ -23,6 +23,7 @@
 
 #include "reports/font.h"
 #include "reports/report.h"
+#include "reports/audit_images.h"
 #include "reports/zfight_image.h"
 
 namespace va {
@@ -258,6 +259,9 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
     if (view.zfightRan && !writeZFightImage(view.zfight, zb, prefix + names.zfightPng, err)) return false;
+    // BASE.culling.png: the reference visibility colored by each pixel's fate (reports/audit_images.h).
+    if (view.auditRan && !writeCullingImage(view.reference, view.cullAudit, prefix + names.cullingPng, err))
+        return false;
     return true;
 }
 

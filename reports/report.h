@@ -41,6 +41,7 @@ struct ViewImageNames {
     std::string overdrawPng;  // BASE.overdraw.png
     std::string idsExr;       // BASE.ids.exr
     std::string zfightPng;    // BASE.zfight.png (when the z-fighting analysis ran)
+    std::string cullingPng;   // BASE.culling.png (when the audit ran)
 };
 ViewImageNames viewImageNames(const std::string &baseName);
 

@@ -68,7 +68,7 @@ std::vector<std::string> imageBaseNames(const std::vector<ViewSpec> &views) {
 
 ViewImageNames viewImageNames(const std::string &baseName) {
     return {baseName + ".depth.exr", baseName + ".depth.png", baseName + ".overdraw.png", baseName + ".ids.exr",
-            baseName + ".zfight.png"};
+            baseName + ".zfight.png", baseName + ".culling.png"};
 }
 
 // ---- JSON -------------------------------------------------------------------------------------
@@ -163,6 +163,48 @@ Json cameraJson(const CameraSpec &c) {
     else j["fov_y"] = num(c.fovYDegrees);
     j["near"] = num(c.nearZ);
     j["far"] = num(c.farZ);
+    return j;
+}
+
+// The audit against the reference visibility (analysis/audit.h; docs/audits.md).
+Json auditJson(const ViewResult &v) {
+    const ReferenceVisibility &ref = v.reference;
+    const CullAudit &a = v.cullAudit;
+    Json j;
+    j["ran"] = true;
+    j["reference"] = {{"triangles_in", ref.trianglesIn},
+                      {"visible_triangles", ref.visibleTriangles},
+                      {"visible_objects", ref.visibleObjects},
+                      {"covered_pixels", ref.coveredPixels},
+                      {"back_winding", ref.backWinding},
+                      {"fragments", ref.fragments}};
+    Json byStage = Json::object();
+    uint64_t falseObjects = 0;
+    for (const StageCullAudit &s : a.stages) {
+        Json worst = Json::array();
+        for (const FalseCullOffender &o : s.worst)
+            worst.push_back({{"object", o.object}, {"name", o.name}, {"triangles", o.triangles}, {"pixels", o.pixels}});
+        byStage[s.stage] = {{"triangles_culled", s.trianglesCulled},
+                            {"objects_culled", s.objectsCulled},
+                            {"false_cull_triangles", s.falseCullTriangles},
+                            {"false_cull_objects", s.falseCullObjects},
+                            {"false_cull_pixels", s.falseCullPixels},
+                            {"worst", worst}};
+        falseObjects += s.falseCullObjects;
+    }
+    j["false_culls"] = {{"triangles", a.falseCullTriangles},
+                        {"objects", falseObjects},
+                        {"pixels", a.falseCullPixels},
+                        {"by_stage", byStage}};
+    j["wasted_draws"] = {{"drawn_triangles", a.drawnTriangles},
+                         {"drawn_objects", a.drawnObjects},
+                         {"triangles", a.wastedTriangles},
+                         {"objects", a.wastedObjects},
+                         {"drawn_fragments", a.drawnFragments},
+                         {"fragments", a.wastedFragments},
+                         {"share", a.drawnTriangles ? double(a.wastedTriangles) / double(a.drawnTriangles) : 0.0}};
+    j["unaccounted_pixels"] = a.unaccountedPixels;
+    j["ms"] = num(v.auditMs);
     return j;
 }
 
@@ -270,6 +312,10 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
         vj["stages"] = stages;
         vj["zbuffer"] = zbufferJson(v.zbuffer);
         const ViewImageNames names = viewImageNames(v.imageBase.empty() ? bases[i] : v.imageBase);
+        if (v.auditRan)
+            vj["audit"] = auditJson(v);
+        else
+            vj["audit"] = {{"ran", false}, {"reason", v.auditReason}};
         if (v.zfightRan)
             vj["depth"] = depthJson(v.zfight, v.zfightMs);
         else
@@ -279,6 +325,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
                         {"overdraw_png", names.overdrawPng},
                         {"ids_exr", names.idsExr}};
         if (v.zfightRan) vj["images"]["zfight_png"] = names.zfightPng;
+        if (v.auditRan) vj["images"]["culling_png"] = names.cullingPng;
         vj["total_ms"] = num(v.totalMs);
         views.push_back(vj);
     }

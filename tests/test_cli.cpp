@@ -272,7 +272,7 @@ TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
         ++images;
         EXPECT_EQ(slurp(e.path()), slurp(dir_ / "merged" / e.path().filename())) << e.path();
     }
-    EXPECT_EQ(images, 9u * 5u);  // depth.exr, depth.png, overdraw.png, ids.exr, zfight.png
+    EXPECT_EQ(images, 9u * 6u);  // depth.exr, depth.png, overdraw.png, ids.exr, zfight.png, culling.png
     // Missing and overlapping shards are refused.
     RunResult bad = run("merge " + (dir_ / "shard1").string() + " " + (dir_ / "shard2").string() + " --out " +
                         (dir_ / "bad").string());
@@ -293,7 +293,8 @@ TEST_F(CliTest, CheckPassesALooseBudgetAndFailsATightOneWithJUnit) {
     RunResult r = run("check --budget " + loose.string() + " --quiet --out " + (dir_ / "a").string() + " --junit " +
                       (dir_ / "a.xml").string());
     EXPECT_EQ(r.code, 0) << r.err << r.out;
-    EXPECT_NE(r.out.find("4 passed, 0 failed"), std::string::npos) << r.out;
+    // 2 views x (2 limits + false_culls, checked with limit 0 by default where the audit ran)
+    EXPECT_NE(r.out.find("6 passed, 0 failed"), std::string::npos) << r.out;
     r = run("check --budget " + tight.string() + " --quiet --out " + (dir_ / "b").string() + " --junit " +
             (dir_ / "b.xml").string());
     EXPECT_EQ(r.code, 1) << r.err << r.out;
@@ -304,7 +305,7 @@ TEST_F(CliTest, CheckPassesALooseBudgetAndFailsATightOneWithJUnit) {
               std::string::npos)
         << r.out;
     const std::string xml = slurp(dir_ / "b.xml");
-    EXPECT_NE(xml.find("<testsuites name=\"visaudit check\" tests=\"3\" failures=\"1\">"), std::string::npos) << xml;
+    EXPECT_NE(xml.find("<testsuites name=\"visaudit check\" tests=\"5\" failures=\"1\">"), std::string::npos) << xml;
     EXPECT_NE(xml.find("<failure message=\"zbuffer_triangles in view &apos;spawn&apos; is"), std::string::npos) << xml;
     // Well-formed: every opened testcase with a failure is closed; the document closes.
     EXPECT_EQ(xml.substr(xml.size() - 14), "</testsuites>\n");
