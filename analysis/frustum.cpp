@@ -112,10 +112,11 @@ int classifySphere(const FrustumPlanes &fp, const Sphere &s, uint32_t *mask, uin
     return result;
 }
 
-FrustumResult cullFrustum(const Scene &scene, const ObjectBvh &bvh, const Camera &cam) {
+FrustumResult cullFrustum(const Scene &scene, const ObjectBvh &bvh, const Camera &cam,
+                          const std::vector<uint32_t> *candidates) {
     FrustumResult r;
     FrustumStats &st = r.stats;
-    st.objectsIn = scene.objects.size();
+    st.objectsIn = candidates ? candidates->size() : scene.objects.size();
     st.planeTestsBruteForce = 6 * st.objectsIn;
     if (bvh.nodes.empty()) return r;
     const FrustumPlanes fp = worldFrustumPlanes(cam);
@@ -159,7 +160,11 @@ FrustumResult cullFrustum(const Scene &scene, const ObjectBvh &bvh, const Camera
             stack.push_back({nd.first, mask});
         }
     }
+    std::vector<uint8_t> input(scene.objects.size(), candidates ? 0 : 1);
+    if (candidates)
+        for (uint32_t o : *candidates) input[o] = 1;
     for (uint32_t o = 0; o < state.size(); ++o) {
+        if (!input[o]) continue;
         if (state[o] == 0) {
             ++st.objectsCulled;
         } else {

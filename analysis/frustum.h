@@ -35,7 +35,10 @@ struct FrustumResult {
     std::vector<uint32_t> visible;  // kept objects, ascending (submission order)
     FrustumStats stats;
 };
-FrustumResult cullFrustum(const Scene &scene, const ObjectBvh &bvh, const Camera &cam);
+// `candidates` (optional, ascending): the objects a coarser stage kept; the others are not this
+// stage's input (neither counted nor returned). Null: every object.
+FrustumResult cullFrustum(const Scene &scene, const ObjectBvh &bvh, const Camera &cam,
+                          const std::vector<uint32_t> *candidates = nullptr);
 
 // Sphere against planes with a conservative margin: -1 outside some plane, +1 inside all, 0 else.
 // `mask` holds the planes still to test (bit i = plane i); planes the sphere is inside are cleared.

@@ -5,12 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "analysis/load_bsp.h"
 #include "analysis/scene.h"
 
 namespace va {
 
 struct LoadOptions {
     ChunkSettings chunks;
+    BspOptions bsp;  // Quake 3 maps: patch tessellation level
 };
 
 // Loads any supported input: *.json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb.

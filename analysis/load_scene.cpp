@@ -453,7 +453,7 @@ bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::str
 
 bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
     // Quake 3 maps: "x.bsp", or a member of a .pk3 archive, "pak.pk3:maps/x.bsp" (analysis/load_bsp.h).
-    if (isBspPath(path)) return loadBspScene(path, BspOptions{}, opt.chunks, out, err);
+    if (isBspPath(path)) return loadBspScene(path, opt.bsp, opt.chunks, out, err);
     const std::string ext = lowerExt(path);
     if (ext == ".json") {
         // Every expected failure returns false; this only turns a library exception we did not

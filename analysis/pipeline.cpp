@@ -8,6 +8,8 @@
 #include <tbb/parallel_for.h>
 
 #include "analysis/backface.h"
+#include "analysis/cells.h"
+#include "analysis/level_views.h"
 #include "render/raster.h"
 
 namespace va {
@@ -40,6 +42,24 @@ PreparedScene prepareScene(const Scene &scene) {
     return ps;
 }
 
+bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err) {
+    PreparedScene ps = prepareScene(scene);
+    ps.effects = planEffects(scene, s.effects);
+    if (s.raycast) {
+        const auto t0 = Clock::now();
+        ps.rays = std::make_unique<RayScene>();
+        // The float frame's origin at the scene's center keeps float precision where the geometry is.
+        const Vec3 origin = scene.bounds.empty() ? Vec3{} : scene.bounds.center();
+        if (!ps.rays->build(MeshView{scene.positions.data(), scene.indices.data()}, scene.positions.size(),
+                            scene.objectTriangles, origin, err))
+            return false;
+        ps.raySceneBuildMs = msSince(t0);
+        ps.effectsData = effectsDataFor(scene);
+    }
+    *out = std::move(ps);
+    return true;
+}
+
 bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, Camera *cam, std::string *err) {
     ViewSpec v = in;
     if (s.width > 0) v.camera.width = s.width;
@@ -68,41 +88,63 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     r.spec = view;
     r.camera = cam;
 
-    // Coarse stage: cells/PVS where the scene has them (not in this scene model yet).
-    r.stages.push_back(skipped("cells", "scene has no cells, portals or PVS"));
-
-    // Frustum: bounding spheres over the object BVH.
-    std::vector<uint32_t> objects;
+    std::vector<uint32_t> objects(scene.objects.size());  // the objects still in, ascending
+    for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
     std::vector<StageCulls> culls;  // what each culling stage removed, for the audit
-    const uint64_t sceneTriangles = scene.objectTriangles.size();
+    // The objects of `before` missing from `after` (both ascending).
+    auto removed = [](const std::vector<uint32_t> &before, const std::vector<uint32_t> &after) {
+        std::vector<uint32_t> out;
+        size_t k = 0;
+        for (uint32_t o : before) {
+            if (k < after.size() && after[k] == o)
+                ++k;
+            else
+                out.push_back(o);
+        }
+        return out;
+    };
+
+    // Coarse stage: cells (a map's PVS) where the scene has them.
+    {
+        const char *why = cellsSkipReason(scene);
+        if (!why && !s.cells) why = "turned off by --no-cells";
+        if (why) {
+            r.stages.push_back(skipped("cells", why));
+        } else {
+            StageRecord st;
+            st.name = "cells";
+            const auto t0 = Clock::now();
+            CellsResult c = cullCells(scene, cam);
+            st.ms = msSince(t0);
+            st.ran = true;
+            st.trianglesIn = trianglesOf(scene, objects);
+            if (s.audit) culls.push_back({"cells", removed(objects, c.visible), {}});
+            objects = std::move(c.visible);
+            st.trianglesOut = trianglesOf(scene, objects);
+            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
+            r.cells = c.stats;
+            r.cellsNote = c.note;
+            r.stages.push_back(st);
+        }
+    }
+
+    // Frustum: bounding spheres over the object BVH, of the objects the coarse stage kept.
     {
         StageRecord st;
         st.name = "frustum";
         if (s.frustum) {
             const auto t0 = Clock::now();
-            FrustumResult f = cullFrustum(scene, ps.bvh, cam);
+            FrustumResult f = cullFrustum(scene, ps.bvh, cam, &objects);
             st.ms = msSince(t0);
             st.ran = true;
-            objects = std::move(f.visible);
             r.frustum = f.stats;
-            if (s.audit) {
-                StageCulls c{"frustum", {}, {}};
-                size_t k = 0;
-                for (uint32_t o = 0; o < scene.objects.size(); ++o) {
-                    if (k < objects.size() && objects[k] == o)
-                        ++k;
-                    else
-                        c.objects.push_back(o);
-                }
-                culls.push_back(std::move(c));
-            }
-            st.trianglesIn = sceneTriangles;
+            st.trianglesIn = trianglesOf(scene, objects);
+            if (s.audit) culls.push_back({"frustum", removed(objects, f.visible), {}});
+            objects = std::move(f.visible);
             st.trianglesOut = trianglesOf(scene, objects);
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;
             r.stages.push_back(st);
         } else {
-            objects.resize(scene.objects.size());
-            for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
             r.stages.push_back(skipped("frustum", "turned off by --no-frustum"));
         }
     }
@@ -181,6 +223,43 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         r.stages.push_back(st);
     }
 
+    // Raycast: Embree primary rays over the whole scene with no culling (single-sided triangles seen
+    // from their front only, as the reference sees them; ties to the lowest id), compared pixel by
+    // pixel with the z-buffer; then the secondary rays the effects plan calls for.
+    if (ps.rays) {
+        StageRecord st;
+        st.name = "raycast";
+        const auto t0 = Clock::now();
+        PrimaryOptions opt;
+        opt.rejectBackFaces = s.backface;
+        opt.doubleSided = ps.effectsData.doubleSided.data();
+        opt.planes = scene.planes.data();
+        opt.tiesToLowestId = true;
+        opt.keepBarycentrics = ps.effects.tracesRays();
+        r.raycastImage = ps.rays->castPrimary(cam, opt, &r.raycast);
+        st.ms = msSince(t0);
+        st.ran = true;
+        r.raycastRan = true;
+        st.trianglesIn = scene.objectTriangles.size();
+        std::vector<uint8_t> seen(scene.triangleCount(), 0);
+        for (uint32_t id : r.raycastImage.id)
+            if (id && !seen[id - 1]) {
+                seen[id - 1] = 1;
+                ++st.trianglesOut;
+            }
+        // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
+        st.trianglesCulled = st.trianglesIn - st.trianglesOut;
+        r.stages.push_back(st);
+        r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, r.raycastImage.id, r.raycastImage.depth, scene, cam,
+                                  makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ), ps.rays->origin());
+        if (ps.effects.tracesRays()) {
+            r.effects = traceEffects(*ps.rays, cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
+            r.effectsRan = true;
+        }
+    } else {
+        r.stages.push_back(skipped("raycast", "turned off by --no-raycast"));
+    }
+
     // Audit: the reference visibility (no culling at all), and what each culling stage removed
     // that is in fact visible (false culls) or kept that is visible nowhere (wasted draws).
     if (s.audit) {
@@ -224,9 +303,24 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
     out->bounds = scene.bounds;
     out->views.assign(views.size(), ViewResult{});
 
-    const PreparedScene ps = prepareScene(scene);
     std::optional<tbb::global_control> threads;
     if (s.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(s.threads));
+    PreparedScene ps;
+    if (!prepareScene(scene, s, &ps, err)) return false;
+    out->effects = ps.effects;
+    out->raycast = ps.rays != nullptr;
+    out->raySceneBuildMs = ps.raySceneBuildMs;
+    for (const Light &l : scene.lights) out->lightNames.push_back(l.name);
+    if (scene.bsp) {
+        AnalysisResult::BspSummary b;
+        b.faces = scene.bsp->faceCounts;
+        b.leafs = scene.bsp->leafs.size();
+        b.clusters = scene.bsp->clusterCount;
+        b.patchLevel = scene.bsp->patchLevel;
+        b.hasPvs = scene.bsp->hasPvs();
+        b.spawnPoints = spawnViews(scene).size();
+        out->bsp = b;
+    }
     std::mutex errMutex;
     std::string firstErr;
     std::atomic<bool> failed{false};
@@ -234,6 +328,11 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         if (failed) return;
         ViewResult v = analyzeView(ps, resolved[i], cams[i], s);
         std::string e;
+        if (v.effectsRan && !v.effects.ok) {
+            std::lock_guard<std::mutex> lock(errMutex);
+            if (!failed.exchange(true)) firstErr = "view '" + v.spec.name + "': effects: " + v.effects.error;
+            return;
+        }
         if (onView && !onView(i, v, &e)) {
             std::lock_guard<std::mutex> lock(errMutex);
             if (!failed.exchange(true)) firstErr = e;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include "analysis/results.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
+#include "analysis/effects_plan.h"
+#include "render/raycast.h"
 #include "render/clip.h"
 
 namespace va {
@@ -21,6 +24,7 @@ struct Limits {
 };
 
 struct PipelineSettings {
+    bool cells = true;     // --no-cells turns the stage off (where the scene has cells or a PVS)
     bool frustum = true;   // --no-frustum turns the stage off
     bool backface = true;  // --no-backface turns the stage off
     int width = 0, height = 0;                 // > 0: override every view's resolution
@@ -28,6 +32,8 @@ struct PipelineSettings {
     ClipSettings clip;
     bool zfight = true;    // --no-zfight turns the z-fighting analysis off
     bool audit = true;     // --no-audit turns the reference-visibility audit off
+    bool raycast = true;   // --no-raycast turns the raycast stage (and the effects) off
+    EffectFlags effects;   // --shadows/--no-shadows, ..., --max-depth
     ZFightSettings zfightSettings;
     Limits limits;
     int threads = 0;                           // 0: all cores
@@ -37,8 +43,16 @@ struct PipelineSettings {
 struct PreparedScene {
     const Scene *scene = nullptr;
     ObjectBvh bvh;
+    std::unique_ptr<RayScene> rays;  // Embree scene over every analysed triangle (raycast on)
+    double raySceneBuildMs = 0;
+    SceneEffectsData effectsData;
+    EffectPlan effects;
 };
+// Without ray casting (tests of the rasterizing stages).
 PreparedScene prepareScene(const Scene &scene);
+// As the settings say: the Embree scene and the effects plan when raycast is on. False + message
+// when Embree fails.
+bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err);
 
 // The view after settings' overrides, validated; false with a message naming the view and a fix.
 bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, Camera *cam, std::string *err);

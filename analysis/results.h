@@ -4,14 +4,19 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "analysis/audit.h"
+#include "analysis/cells.h"
+#include "analysis/effects_plan.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
 #include "render/clip.h"
 #include "render/raster.h"
+#include "render/effects.h"
+#include "render/raycast.h"
 
 namespace va {
 
@@ -54,6 +59,16 @@ struct ViewResult {
     ClipStats clip;
     ZBufferStats zbuffer;
     ZBuffer buffer;                   // per-pixel buffers, for the images (may be released after writing)
+    CellsStats cells;                 // the cells stage (PVS), when it ran
+    std::string cellsNote;            // e.g. the camera is in the void
+    // The raycast stage: Embree primary rays at pixel centers over the whole scene (no culling),
+    // cross-checked pixel by pixel against the z-buffer; secondary rays where the plan says.
+    bool raycastRan = false;
+    RaycastStats raycast;
+    CrossCheck crossCheck;
+    RaycastImage raycastImage;        // ids/depths for NAME.raycast.ids.exr (released after writing)
+    bool effectsRan = false;
+    EffectsResult effects;
     // Audit against the reference visibility (docs/audits.md): per-pixel buffers are released once
     // the images are written.
     bool auditRan = false;
@@ -76,6 +91,20 @@ struct AnalysisResult {
     uint64_t sourceObjects = 0;
     Aabb bounds;
     double loadMs = 0;
+    EffectPlan effects;               // which effects the scene calls for, and why (docs/effects.md)
+    std::vector<std::string> lightNames;
+    // A Quake 3 map's structure, summarized (scenes loaded from a .bsp; docs/quake3.md).
+    struct BspSummary {
+        BspFaceCounts faces;
+        uint64_t leafs = 0;
+        int32_t clusters = 0;
+        int patchLevel = 0;
+        bool hasPvs = false;
+        uint64_t spawnPoints = 0;     // views --views spawns makes (spawn and intermission points)
+    };
+    std::optional<BspSummary> bsp;
+    bool raycast = false;             // whether the raycast stage ran
+    double raySceneBuildMs = 0;       // Embree BVH build over the scene (once, for every view)
     // --shard K/N: this report holds the views whose index i has i % N == K - 1.
     struct Shard {
         int index = 1, count = 1;     // K and N (1-based K); 1/1 = every view

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <sstream>
 #include <mutex>
 #include <string>
@@ -21,6 +22,7 @@
 
 #include "analysis/demo.h"
 #include "analysis/depth_audit.h"
+#include "analysis/level_views.h"
 #include "analysis/load.h"
 #include "analysis/pipeline.h"
 #include "reports/console.h"
@@ -44,7 +46,11 @@ struct Options {
     int threads = 0;
     int maxResolution = 16384;
     uint32_t chunk = 512;
-    bool noBackface = false, noFrustum = false, noZFight = false, noAudit = false;
+    bool noBackface = false, noFrustum = false, noZFight = false, noAudit = false, noCells = false, noRaycast = false;
+    int patchLevel = 5;
+    // Effects: unset = the scene decides.
+    std::optional<bool> shadows, reflections, refractions, abuffer;
+    int maxDepth = 4;
     uint64_t zfightMinArea = 1;
     bool quiet = false;
     bool json = false;  // --json: the summary on stdout
@@ -70,12 +76,20 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
     } else {
         LoadOptions lo;
         lo.chunks.maxTriangles = o.chunk;
+        lo.bsp.patchLevel = o.patchLevel;
         if (!loadScene(o.scene, lo, scene, &err)) {
             fail(err);
             return false;
         }
     }
-    if (o.views.empty()) {
+    bool handled = false;
+    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err)) {
+        fail(err);
+        return false;
+    }
+    if (handled) {
+        // spawns, walk:N: the map's own views
+    } else if (o.views.empty()) {
         *views = scene->views;
     } else if (o.views.rfind("orbit:", 0) == 0) {
         const std::string n = o.views.substr(6);
@@ -103,6 +117,13 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->backface = !o.noBackface;
     s->zfight = !o.noZFight;
     s->audit = !o.noAudit;
+    s->cells = !o.noCells;
+    s->raycast = !o.noRaycast;
+    s->effects.shadows = o.shadows;
+    s->effects.reflections = o.reflections;
+    s->effects.refractions = o.refractions;
+    s->effects.abuffer = o.abuffer;
+    s->effects.maxDepth = o.maxDepth;
     s->zfightSettings.minHotspotArea = o.zfightMinArea;
     s->width = o.width;
     s->height = o.height;
@@ -463,7 +484,9 @@ void addDepthAuditOptions(CLI::App *c, Options &o) {
 void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("scene", o.scene, "Scene file: .json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb; "
                                     "none = the built-in demo");
-    c->add_option("--views", o.views, "Views: a views file (.json), or orbit:N (N cameras around the scene)");
+    c->add_option("--views", o.views, "Views: a views file (.json); orbit:N (N cameras around the scene); for a "
+                                      "Quake 3 map, spawns (its spawn points) or walk:N[:SEED] (N points inside its clusters)");
+    c->add_option("--patch-level", o.patchLevel, "Quake 3 maps: segments per Bezier patch edge")->check(CLI::Range(1, 64));
     c->add_option("--chunk", o.chunk, "Split meshes into culling objects of at most this many triangles")
         ->check(CLI::Range(1u, 1u << 30));
 }
@@ -481,6 +504,19 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
     c->add_flag("--no-zfight", o.noZFight, "Turn the z-fighting analysis off");
     c->add_flag("--no-audit", o.noAudit, "Turn the reference-visibility audit (false culls, wasted draws) off");
+    c->add_flag("--no-cells", o.noCells, "Turn the cells stage (a map's PVS, portals) off");
+    c->add_flag("--no-raycast", o.noRaycast, "Turn the raycast stage (Embree cross-check, secondary rays) off");
+    // Effects: the scene decides (lights, reflective, refractive, transparent materials); a flag forces.
+    auto effect = [&](const char *on, const char *off, std::optional<bool> &v, const char *what) {
+        c->add_flag_callback(on, [&v] { v = true; }, std::string("Force ") + what + " on");
+        c->add_flag_callback(off, [&v] { v = false; }, std::string("Force ") + what + " off");
+    };
+    effect("--shadows", "--no-shadows", o.shadows, "shadow rays");
+    effect("--reflections", "--no-reflections", o.reflections, "reflection rays");
+    effect("--refractions", "--no-refractions", o.refractions, "refraction rays");
+    effect("--abuffer", "--no-abuffer", o.abuffer, "the A-buffer");
+    c->add_option("--max-depth", o.maxDepth, "Deepest secondary ray (reflection/refraction recursion)")
+        ->check(CLI::Range(0, 255));
     c->add_option("--zfight-min-area", o.zfightMinArea, "Smallest hotspot, in pixels (smaller clusters still count as fighting pixels)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");

@@ -5,23 +5,17 @@
 #include <cmath>
 
 #include "reports/font.h"
+#include "reports/legend.h"
 
 namespace va {
 
 namespace {
-
-constexpr Rgb8 kStrip{24, 24, 24};
-constexpr Rgb8 kText{255, 255, 255};
 
 void put(std::vector<uint8_t> &rgb, int w, int x, int y, Rgb8 c) {
     uint8_t *p = &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3];
     p[0] = c.r;
     p[1] = c.g;
     p[2] = c.b;
-}
-void fill(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c) {
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) put(rgb, w, x, y, c);
 }
 
 // Nearest and farthest finite positive depth (the range of depthGray).
@@ -33,42 +27,6 @@ void depthRange(const std::vector<double> &depth, double *lo, double *hi) {
             *lo = std::min(*lo, d);
             *hi = std::max(*hi, d);
         }
-}
-
-// A legend strip below an image of width W, height H: swatches with their labels in one row,
-// left-aligned, wrapping onto more rows when wider than the canvas. Sizes scale with the font
-// scale s: row height = margin 3s + text 7s (swatch as tall as the text) + margin 3s.
-struct LegendEntry {
-    Rgb8 color;
-    std::string label;
-};
-std::vector<uint8_t> withLegend(const std::vector<uint8_t> &image, int W, int H, const std::vector<LegendEntry> &entries,
-                                int *canvasH) {
-    const int s = W >= 1024 ? 2 : 1;
-    const int margin = 3 * s, rowH = margin + textHeight(s) + margin, swatch = textHeight(s);
-    // Lay out the entries: swatch, gap 2s, label, gap 6s.
-    std::vector<std::pair<int, int>> at;  // (x, row)
-    int x = margin, row = 0;
-    for (const LegendEntry &e : entries) {
-        const int ew = swatch + 2 * s + textWidth(e.label, s);
-        if (x > margin && x + ew > W - margin) {
-            x = margin;
-            ++row;
-        }
-        at.push_back({x, row});
-        x += ew + 6 * s;
-    }
-    const int strip = (row + 1) * rowH;
-    *canvasH = H + strip;
-    std::vector<uint8_t> rgb(size_t(W) * size_t(*canvasH) * 3);
-    std::copy(image.begin(), image.end(), rgb.begin());
-    fill(rgb, W, 0, H, W, *canvasH, kStrip);
-    for (size_t i = 0; i < entries.size(); ++i) {
-        const int ex = at[i].first, ey = H + at[i].second * rowH + margin;
-        fill(rgb, W, ex, ey, std::min(ex + swatch, W), std::min(ey + swatch, *canvasH), entries[i].color);
-        drawText(rgb.data(), W, *canvasH, ex + swatch + 2 * s, ey, entries[i].label, {kText.r, kText.g, kText.b}, s);
-    }
-    return rgb;
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "reports/font.h"
 #include "reports/report.h"
 #include "reports/audit_images.h"
+#include "reports/effects_images.h"
 #include "reports/zfight_image.h"
 
 namespace va {
@@ -262,6 +263,19 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     // BASE.culling.png: the reference visibility colored by each pixel's fate (reports/audit_images.h).
     if (view.auditRan && !writeCullingImage(view.reference, view.cullAudit, prefix + names.cullingPng, err))
         return false;
+    // The raycast stage: its ids, and where it disagrees with the z-buffer (reports/audit_images.h).
+    if (view.raycastRan) {
+        if (!writeRaycastIds(view.raycastImage.width, view.raycastImage.height, view.raycastImage.id,
+                             prefix + names.raycastIdsExr, err) ||
+            !writeRaycastDiffImage(zb, view.crossCheck, prefix + names.raycastDiffPng, err))
+            return false;
+    }
+    // Secondary rays: one shadow image per light, the depth of the ray trees (reports/effects_images.h).
+    if (view.effectsRan) {
+        for (size_t l = 0; l < view.effects.lights.size(); ++l)
+            if (!writeShadowImage(view.effects, l, zb, prefix + shadowImageName(names, l, view), err)) return false;
+        if (!writeSecondaryImage(view.effects, zb, prefix + names.secondaryPng, err)) return false;
+    }
     return true;
 }
 

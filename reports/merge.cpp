@@ -126,14 +126,21 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
 
     // Images: copy every file a view lists.
     for (size_t idx = 0; idx < total; ++idx)
-        for (const auto &[key, name] : (*views[idx])["images"].items()) {
-            if (!name.is_string()) continue;
-            const fs::path src = fs::path(dirs[owner[idx]]) / name.get<std::string>();
-            std::error_code ec;
-            fs::copy_file(src, fs::path(outDir) / name.get<std::string>(), fs::copy_options::overwrite_existing, ec);
-            if (ec) {
-                *err = src.string() + ": cannot copy (" + ec.message() + ")";
-                return false;
+        for (const auto &[key, value] : (*views[idx])["images"].items()) {
+            // A name, or a list of names (one shadow image per light).
+            std::vector<std::string> names;
+            if (value.is_string()) names.push_back(value);
+            if (value.is_array())
+                for (const Json &n : value)
+                    if (n.is_string()) names.push_back(n);
+            for (const std::string &name : names) {
+                const fs::path src = fs::path(dirs[owner[idx]]) / name;
+                std::error_code ec;
+                fs::copy_file(src, fs::path(outDir) / name, fs::copy_options::overwrite_existing, ec);
+                if (ec) {
+                    *err = src.string() + ": cannot copy (" + ec.message() + ")";
+                    return false;
+                }
             }
         }
 

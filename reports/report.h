@@ -42,8 +42,15 @@ struct ViewImageNames {
     std::string idsExr;       // BASE.ids.exr
     std::string zfightPng;    // BASE.zfight.png (when the z-fighting analysis ran)
     std::string cullingPng;   // BASE.culling.png (when the audit ran)
+    std::string raycastIdsExr;   // BASE.raycast.ids.exr (when the raycast stage ran)
+    std::string raycastDiffPng;  // BASE.raycast_diff.png
+    std::string secondaryPng;    // BASE.secondary.png (when secondary rays ran)
+    std::string base;            // BASE itself
 };
 ViewImageNames viewImageNames(const std::string &baseName);
+// BASE.shadow.LIGHT.png for light l of the view's effects (the light's name sanitized; its index
+// when the sanitized name is empty or repeats).
+std::string shadowImageName(const ViewImageNames &names, size_t light, const ViewResult &view);
 
 // ---- Images ------------------------------------------------------------------------------------
 // Writes BASE.depth.exr, BASE.depth.png, BASE.overdraw.png and BASE.ids.exr for one view into dir

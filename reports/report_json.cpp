@@ -68,7 +68,18 @@ std::vector<std::string> imageBaseNames(const std::vector<ViewSpec> &views) {
 
 ViewImageNames viewImageNames(const std::string &baseName) {
     return {baseName + ".depth.exr", baseName + ".depth.png", baseName + ".overdraw.png", baseName + ".ids.exr",
-            baseName + ".zfight.png", baseName + ".culling.png"};
+            baseName + ".zfight.png", baseName + ".culling.png", baseName + ".raycast.ids.exr",
+            baseName + ".raycast_diff.png", baseName + ".secondary.png", baseName};
+}
+
+std::string shadowImageName(const ViewImageNames &names, size_t light, const ViewResult &view) {
+    const std::vector<LightShadowStats> &lights = view.effects.lights;
+    std::string name = lights[light].name.empty() ? std::string() : sanitizeFileName(lights[light].name);
+    bool repeated = false;
+    for (size_t k = 0; k < lights.size(); ++k)
+        if (k != light && !lights[k].name.empty() && sanitizeFileName(lights[k].name) == name) repeated = true;
+    if (name.empty() || repeated) name = "light" + std::to_string(light);
+    return names.base + ".shadow." + name + ".png";
 }
 
 // ---- JSON -------------------------------------------------------------------------------------
@@ -133,6 +144,70 @@ Json zbufferStageJson(const ZBufferStats &z) {
     return j;
 }
 
+Json cellsJson(const CellsStats &c, const std::string &note) {
+    Json j;
+    j["camera_leaf"] = c.cameraLeaf;
+    j["camera_cluster"] = c.cameraCluster;
+    j["camera_in_void"] = c.cameraInVoid;
+    j["clusters_visible"] = c.clustersVisible;
+    j["clusters_total"] = c.clustersTotal;
+    j["objects_in"] = c.objectsIn;
+    j["objects_culled"] = c.objectsCulled;
+    j["objects_no_cluster"] = c.objectsNoCluster;
+    j["note"] = note;
+    return j;
+}
+
+Json raycastStageJson(const RaycastStats &r) {
+    return {{"rays", r.rays}, {"hits", r.hits}, {"packets", r.packets}};
+}
+
+// The raycast stage's cross-check with the z-buffer and the secondary rays (docs/audits.md,
+// docs/effects.md).
+Json raycastJson(const ViewResult &v, const std::vector<std::string> &lightNames) {
+    Json j;
+    j["ran"] = true;
+    const CrossCheck &c = v.crossCheck;
+    Json examples = Json::array();
+    for (const CrossCheck::Example &e : c.genuineExamples)
+        examples.push_back({{"x", e.x}, {"y", e.y}, {"zbuffer_id", e.zbufferId}, {"raycast_id", e.raycastId}});
+    j["cross_check"] = {{"pixels", c.pixels},
+                        {"agree", c.agree},
+                        {"edge", c.edge},
+                        {"tie", c.tie},
+                        {"genuine", c.genuine},
+                        {"one_sided_background", c.oneSidedBackground},
+                        {"max_relative_depth_difference", num(c.maxRelativeDepthDifference)},
+                        {"genuine_examples", examples},
+                        {"ms", num(c.ms)}};
+    if (v.effectsRan) {
+        const EffectsStats &e = v.effects.stats;
+        j["effects"] = {{"rays",
+                         {{"primary", e.primaryRays},
+                          {"shadow", e.shadowRays},
+                          {"reflection", e.reflectionRays},
+                          {"refraction", e.refractionRays}}},
+                        {"primary_hits", e.primaryHits},
+                        {"secondary_hits", e.secondaryHits},
+                        {"total_internal_reflections", e.totalInternalReflections},
+                        {"terminated_by_depth", e.terminatedByDepth},
+                        {"deepest", e.deepest},
+                        {"reflection_weight", num(e.reflectionWeight)},
+                        {"refraction_weight", num(e.refractionWeight)},
+                        {"ms", num(e.ms)}};
+        Json lights = Json::array();
+        for (const LightShadowStats &l : v.effects.lights)
+            lights.push_back({{"name", l.name},
+                              {"shadow_rays", l.shadowRays},
+                              {"lit_pixels", l.litPixels},
+                              {"shadowed_pixels", l.shadowedPixels},
+                              {"facing_away_pixels", l.facingAwayPixels}});
+        j["lights"] = lights;
+    }
+    (void)lightNames;
+    return j;
+}
+
 Json stageJson(const StageRecord &s, const ViewResult &v) {
     Json j;
     j["name"] = s.name;
@@ -149,6 +224,8 @@ Json stageJson(const StageRecord &s, const ViewResult &v) {
         else if (s.name == "backface") own = backfaceJson(v.backface);
         else if (s.name == "clip") own = clipJson(v.clip);
         else if (s.name == "zbuffer") own = zbufferStageJson(v.zbuffer);
+        else if (s.name == "cells") own = cellsJson(v.cells, v.cellsNote);
+        else if (s.name == "raycast") own = raycastStageJson(v.raycast);
         for (auto it = own.begin(); it != own.end(); ++it) j[it.key()] = it.value();
     }
     return j;
@@ -287,8 +364,41 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
     scene["faces_dropped"] = r.sceneStats.facesDropped;
     scene["polygons_triangulated"] = r.sceneStats.polygonsTriangulated;
     scene["bounds"] = {{"min", vec3(r.bounds.lo)}, {"max", vec3(r.bounds.hi)}};
+    if (r.bsp) {
+        const BspFaceCounts &f = r.bsp->faces;
+        scene["bsp"] = {{"faces", f.faces},
+                        {"polygons", f.polygons},
+                        {"patches", f.patches},
+                        {"meshes", f.meshes},
+                        {"billboards", f.billboards},
+                        {"bad", f.bad},
+                        {"sky", f.sky},
+                        {"nodraw", f.nodraw},
+                        {"non_solid", f.nonSolid},
+                        {"polygon_triangles", f.polygonTriangles},
+                        {"patch_triangles", f.patchTriangles},
+                        {"mesh_triangles", f.meshTriangles},
+                        {"sky_triangles", f.skyTriangles},
+                        {"nodraw_triangles", f.nodrawTriangles},
+                        {"non_solid_triangles", f.nonSolidTriangles},
+                        {"unleafed_faces", f.unleafedFaces},
+                        {"model_faces", f.modelFaces},
+                        {"leafs", r.bsp->leafs},
+                        {"clusters", r.bsp->clusters},
+                        {"patch_level", r.bsp->patchLevel},
+                        {"has_pvs", r.bsp->hasPvs},
+                        {"spawn_points", r.bsp->spawnPoints}};
+    }
     j["scene"] = scene;
     j["load_ms"] = num(r.loadMs);
+    Json decisions = Json::array();
+    for (const EffectDecision &d : r.effects.all())
+        decisions.push_back({{"name", d.name}, {"ran", d.run && (d.name != "abuffer")}, {"called_for", d.run},
+                             {"forced", d.forced}, {"reason", d.reason}, {"triangles", d.triangles}});
+    j["effects"] = {{"raycast", r.raycast},
+                    {"ray_scene_build_ms", num(r.raySceneBuildMs)},
+                    {"max_depth", r.effects.maxDepth},
+                    {"decisions", decisions}};
     j["shard"] = {{"index", r.shard.index}, {"count", r.shard.count},
                   {"views_total", r.shard.viewsTotal ? r.shard.viewsTotal : r.views.size()}};
 
@@ -312,6 +422,10 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
         vj["stages"] = stages;
         vj["zbuffer"] = zbufferJson(v.zbuffer);
         const ViewImageNames names = viewImageNames(v.imageBase.empty() ? bases[i] : v.imageBase);
+        if (v.raycastRan)
+            vj["raycast"] = raycastJson(v, r.lightNames);
+        else
+            vj["raycast"] = {{"ran", false}, {"reason", "turned off by --no-raycast"}};
         if (v.auditRan)
             vj["audit"] = auditJson(v);
         else
@@ -326,6 +440,18 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
                         {"ids_exr", names.idsExr}};
         if (v.zfightRan) vj["images"]["zfight_png"] = names.zfightPng;
         if (v.auditRan) vj["images"]["culling_png"] = names.cullingPng;
+        if (v.raycastRan) {
+            vj["images"]["raycast_ids_exr"] = names.raycastIdsExr;
+            vj["images"]["raycast_diff_png"] = names.raycastDiffPng;
+        }
+        if (v.effectsRan) {
+            if (!v.effects.lights.empty()) {
+                Json shadows = Json::array();
+                for (size_t l = 0; l < v.effects.lights.size(); ++l) shadows.push_back(shadowImageName(names, l, v));
+                vj["images"]["shadow_png"] = shadows;
+            }
+            vj["images"]["secondary_png"] = names.secondaryPng;
+        }
         vj["total_ms"] = num(v.totalMs);
         views.push_back(vj);
     }

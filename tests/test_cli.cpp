@@ -272,7 +272,14 @@ TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
         ++images;
         EXPECT_EQ(slurp(e.path()), slurp(dir_ / "merged" / e.path().filename())) << e.path();
     }
-    EXPECT_EQ(images, 9u * 6u);  // depth.exr, depth.png, overdraw.png, ids.exr, zfight.png, culling.png
+    // Exactly the images the report lists: per view depth.exr, depth.png, overdraw.png, ids.exr,
+    // zfight.png, culling.png, raycast.ids.exr, raycast_diff.png, secondary.png and one shadow
+    // image per light (the hall has two lights).
+    size_t listed = 0;
+    for (const auto &v : single["views"])
+        for (const auto &[k, x] : v["images"].items()) listed += x.is_array() ? x.size() : 1;
+    EXPECT_EQ(listed, 9u * 11u);
+    EXPECT_EQ(images, listed);
     // Missing and overlapping shards are refused.
     RunResult bad = run("merge " + (dir_ / "shard1").string() + " " + (dir_ / "shard2").string() + " --out " +
                         (dir_ / "bad").string());

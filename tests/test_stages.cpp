@@ -49,6 +49,14 @@ ViewSpec viewOf(Vec3 eye, Vec3 target, int w = 64, int h = 48, double fov = 60, 
     return v;
 }
 
+// Settings with the frustum and backface stages off (clip and z-buffer only).
+PipelineSettings noCulling() {
+    PipelineSettings s;
+    s.frustum = false;
+    s.backface = false;
+    return s;
+}
+
 ViewResult run(const Scene &scene, const ViewSpec &view, PipelineSettings s = {}) {
     ViewSpec resolved;
     Camera cam;
@@ -164,7 +172,7 @@ TEST(Clip, VertexBehindEyeNothingDrawnFromBehind) {
 
 TEST(Clip, TriangleEntirelyBehindEyeIsTriviallyRejected) {
     const Scene scene = sceneOf({triangleMesh({-1, 0, 3}, {1, 0, 3}, {0, 1, 3})});
-    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), PipelineSettings{false, false});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), noCulling());
     EXPECT_EQ(r.clip.trianglesIn, 1u);
     EXPECT_EQ(r.clip.trivialRejected, 1u);
     EXPECT_EQ(r.zbuffer.fragments, 0u);
@@ -181,7 +189,7 @@ TEST(Clip, VertexExactlyOnNearPlaneIsInside) {
 TEST(Clip, TriangleInAFrustumSidePlaneIsEdgeOn) {
     // All three vertices on the plane through the eye x = 0 (perspective): seen edge-on.
     const Scene scene = sceneOf({triangleMesh({0, 0, -2}, {0, 1, -3}, {0, -1, -4})});
-    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), PipelineSettings{false, false});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), noCulling());
     EXPECT_EQ(r.clip.edgeOn, 1u);
     EXPECT_EQ(r.zbuffer.fragments, 0u);
 }
@@ -190,7 +198,7 @@ TEST(Clip, HugeTriangleIsClippedAtTheGuardBandAndCoversEverything) {
     // A triangle whose projection spans ~1e9 pixels: clipped against the guard band, it must still
     // cover every pixel of the view exactly once.
     const Scene scene = sceneOf({triangleMesh({-1e7, -1e7, -5}, {1e7, -1e7, -5}, {0, 1e7, -5})});
-    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), PipelineSettings{false, false});
+    const ViewResult r = run(scene, viewOf({0, 0, 0}, {0, 0, -1}), noCulling());
     EXPECT_EQ(r.clip.clipped, 1u);
     EXPECT_EQ(r.zbuffer.coveredPixels, 64u * 48u);
     EXPECT_EQ(r.zbuffer.fragments, 64u * 48u);

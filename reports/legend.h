@@ -1,0 +1,27 @@
+// A legend strip below an image: colored swatches with their labels (the culling, ray-cast and
+// shadow images use it; reports/font.h draws the text).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "reports/report.h"
+
+namespace va {
+
+struct LegendEntry {
+    Rgb8 color;
+    std::string label;
+};
+
+// The W x H RGB8 image with a legend strip appended below: swatches with their labels in one row,
+// left-aligned, wrapping onto more rows when wider than the canvas. Sizes scale with the font
+// scale s (2 from 1024 pixels wide): row height = margin 3s + text 7s (swatch as tall as the
+// text) + margin 3s. *canvasH receives the new height.
+std::vector<uint8_t> withLegend(const std::vector<uint8_t> &image, int W, int H, const std::vector<LegendEntry> &entries,
+                                int *canvasH);
+
+// Fills the rectangle [x0, x1) x [y0, y1) of an RGB8 image of width w.
+void fillRect(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c);
+
+}  // namespace va
