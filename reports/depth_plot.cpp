@@ -8,19 +8,15 @@
 //   legend                 x = 920..1190, one 22-pixel row per format from y = 70
 #include "reports/depth_plot.h"
 
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 
 #include "reports/font.h"
+#include "reports/report.h"
 
 namespace va {
 
@@ -31,31 +27,8 @@ constexpr Rgb8 kText{20, 20, 20};
 constexpr Rgb8 kFrame{60, 60, 60};
 constexpr Rgb8 kGrid{215, 215, 215};
 
-std::atomic<unsigned> gPlotTempCounter{0};
-
 // The same protocol as reports/images.cpp: write to PATH.tmp-PID-N, then rename over PATH (atomic
 // within one folder), so a reader never sees half a PNG; the temporary file is removed on failure.
-bool writePngAtomic(const std::string &path, int w, int h, const std::vector<uint8_t> &rgb, std::string *err) {
-    const std::string tmp =
-        path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gPlotTempCounter.fetch_add(1));
-    auto fail = [&](const std::string &msg) {
-        std::remove(tmp.c_str());
-        if (err) *err = "cannot write plot '" + path + "': " + msg;
-        return false;
-    };
-    auto out = OIIO::ImageOutput::create("png");
-    if (!out) return fail("no OpenImageIO PNG writer: " + OIIO::geterror());
-    const OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(tmp, spec)) return fail(out->geterror());
-    if (!out->write_image(OIIO::TypeDesc::UINT8, rgb.data())) {
-        const std::string msg = out->geterror();
-        out->close();
-        return fail(msg);
-    }
-    if (!out->close()) return fail(out->geterror());
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) return fail(std::string("rename: ") + std::strerror(errno));
-    return true;
-}
 
 struct Canvas {
     int w, h;
@@ -257,7 +230,7 @@ bool writeDepthResolutionPlot(const DepthAuditResult &r, const std::string &path
     const std::string xTitle = "VIEW DEPTH D (M), LOG";
     c.text((L.left + L.right - textWidth(xTitle, kScale)) / 2, L.bottom + 40, xTitle, kText);
 
-    return writePngAtomic(path, L.width, L.height, c.rgb, err);
+    return writePngRgb8(path, L.width, L.height, c.rgb.data(), err);
 }
 
 }  // namespace va

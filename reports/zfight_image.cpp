@@ -10,16 +10,11 @@
 // reports/images.cpp (whose writer is file-local; this file keeps its own copy, as depth_plot.cpp).
 #include "reports/zfight_image.h"
 
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 
-#include <OpenImageIO/imageio.h>
 
 #include "reports/font.h"
 
@@ -33,29 +28,6 @@ constexpr Rgb8 kPalette[12] = {
 };
 constexpr Rgb8 kLegendText{255, 255, 255};
 
-std::atomic<unsigned> gZFightTempCounter{0};
-
-bool writePngAtomic(const std::string &path, int w, int h, const std::vector<uint8_t> &rgb, std::string *err) {
-    const std::string tmp =
-        path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gZFightTempCounter.fetch_add(1));
-    auto fail = [&](const std::string &msg) {
-        std::remove(tmp.c_str());
-        if (err) *err = "cannot write image '" + path + "': " + msg;
-        return false;
-    };
-    auto out = OIIO::ImageOutput::create("png");
-    if (!out) return fail("no OpenImageIO PNG writer: " + OIIO::geterror());
-    const OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(tmp, spec)) return fail(out->geterror());
-    if (!out->write_image(OIIO::TypeDesc::UINT8, rgb.data())) {
-        const std::string msg = out->geterror();
-        out->close();
-        return fail(msg);
-    }
-    if (!out->close()) return fail(out->geterror());
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) return fail(std::string("rename: ") + std::strerror(errno));
-    return true;
-}
 
 struct Canvas {
     int w = 0, h = 0;
@@ -188,7 +160,7 @@ bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::stri
         if (err) *err = "cannot write image '" + path + "': " + e;
         return false;
     }
-    return writePngAtomic(path, img.width, img.height, img.rgb, err);
+    return writePngRgb8(path, img.width, img.height, img.rgb.data(), err);
 }
 
 }  // namespace va
