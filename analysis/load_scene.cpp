@@ -3,6 +3,7 @@
 // line:column, the JSON path and a fix (STYLE 10).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -10,6 +11,7 @@
 #include "analysis/json_util.h"
 #include "analysis/load.h"
 #include "analysis/load_bsp.h"
+#include "analysis/portals.h"
 
 namespace va {
 namespace {
@@ -190,6 +192,160 @@ struct Reader {
     }
 };
 
+// Relative flatness and convexity tolerance of a portal polygon: points may stray from its plane
+// (and a corner bend inwards) by this fraction of the polygon's size. An input tolerance, not a
+// rounding bound: typed coordinates of a slanted portal carry a few digits, and the stage itself
+// treats the deviation conservatively (docs/coarse-stages.md).
+constexpr double kPortalFlatness = 1e-6;
+
+// "cells": [{ "name", "min", "max" } or { "name", "planes": [[a, b, c, d], ...] }] and
+// "portals": [{ "name", "cells": [A, B], "points": [[x, y, z], ...] }] (docs/scene-format.md).
+bool readCellsAndPortals(Reader &r, const Json &root, std::vector<Cell> *cellsOut, std::vector<Portal> *portalsOut) {
+    const Path top;
+    std::vector<Cell> cells;
+    std::map<std::string, uint32_t> cellIndex;
+    if (root.contains("cells")) {
+        const Path cp = top / "cells";
+        if (!root["cells"].is_array()) return r.fail(cp, "expected an array of cells, got " + json::typeName(root["cells"]));
+        for (size_t i = 0; i < root["cells"].size(); ++i) {
+            const Path p = cp / i;
+            const Json &j = root["cells"][i];
+            if (!r.object(j, p) || !r.checkKeys(j, p, {"name", "min", "max", "planes"})) return false;
+            Cell c;
+            c.name = "cell" + std::to_string(i);
+            if (j.contains("name") && !r.string(j["name"], p / "name", &c.name)) return false;
+            if (c.name.empty()) return r.fail(p / "name", "a cell name cannot be empty");
+            const bool hasBox = j.contains("min") || j.contains("max");
+            if (hasBox && j.contains("planes"))
+                return r.fail(p / "planes", "give either \"min\" and \"max\" (a box) or \"planes\" (a convex cell), not both", true);
+            if (hasBox) {
+                if (!j.contains("min") || !j.contains("max"))
+                    return r.fail(p, std::string("missing \"") + (j.contains("min") ? "max" : "min") +
+                                         "\": a box cell needs both corners, e.g. \"min\": [0, 0, 0], \"max\": [10, 4, 10]");
+                Vec3 lo, hi;
+                if (!r.vec3(j["min"], p / "min", &lo) || !r.vec3(j["max"], p / "max", &hi)) return false;
+                for (int a = 0; a < 3; ++a)
+                    if (!(lo[a] < hi[a]))
+                        return r.fail(p / "max" / size_t(a), "must be greater than min[" + std::to_string(a) + "] (" +
+                                                                  json::Json(lo[a]).dump() + "): a cell has a volume");
+                c.box.lo = lo;
+                c.box.hi = hi;
+                // Six half-spaces n.p + k >= 0: x - lo.x >= 0, hi.x - x >= 0, ...
+                for (int a = 0; a < 3; ++a) {
+                    Vec3 n{0, 0, 0};
+                    n[a] = 1;
+                    c.faces.push_back({n, -lo[a]});
+                    n[a] = -1;
+                    c.faces.push_back({n, hi[a]});
+                }
+            } else if (j.contains("planes")) {
+                const Path pp = p / "planes";
+                const Json &pl = j["planes"];
+                if (!pl.is_array() || pl.size() < 4)
+                    return r.fail(pp, "expected an array of at least 4 planes [a, b, c, d] (a x + b y + c z + d >= 0 inside), got " +
+                                          (pl.is_array() ? "an array of " + std::to_string(pl.size()) : json::typeName(pl)));
+                for (size_t k = 0; k < pl.size(); ++k) {
+                    const Json &q = pl[k];
+                    if (!q.is_array() || q.size() != 4)
+                        return r.fail(pp / k, "expected a plane [a, b, c, d] (a x + b y + c z + d >= 0 inside), got " +
+                                                  (q.is_array() ? "an array of " + std::to_string(q.size()) : json::typeName(q)));
+                    double v[4];
+                    for (size_t m = 0; m < 4; ++m)
+                        if (!r.number(q[m], pp / k / m, &v[m])) return false;
+                    const Vec3 n{v[0], v[1], v[2]};
+                    const double len = length(n);
+                    if (!(len > 0)) return r.fail(pp / k, "has a zero normal (a, b, c); give the direction pointing into the cell");
+                    c.faces.push_back({n / len, v[3] / len});
+                }
+            } else {
+                return r.fail(p, "missing the cell's shape: \"min\" and \"max\" (a box) or \"planes\" (a convex cell)");
+            }
+            auto [it, fresh] = cellIndex.insert({c.name, uint32_t(i)});
+            if (!fresh)
+                return r.fail(j.contains("name") ? p / "name" : p,
+                              "duplicate cell name '" + c.name + "' (also " + json::pathString(cp / it->second) + "); cell names must be unique");
+            cells.push_back(std::move(c));
+        }
+    }
+    std::vector<Portal> portals;
+    if (root.contains("portals")) {
+        const Path pp = top / "portals";
+        if (!root["portals"].is_array()) return r.fail(pp, "expected an array of portals, got " + json::typeName(root["portals"]));
+        if (cells.empty() && !root["portals"].empty())
+            return r.fail(pp, "portals join cells, but the scene has no \"cells\"; add the cells they join");
+        std::vector<std::string> names;
+        for (const Cell &c : cells) names.push_back(c.name);
+        for (size_t i = 0; i < root["portals"].size(); ++i) {
+            const Path p = pp / i;
+            const Json &j = root["portals"][i];
+            if (!r.object(j, p) || !r.checkKeys(j, p, {"name", "cells", "points"})) return false;
+            Portal po;
+            po.name = "portal" + std::to_string(i);
+            if (j.contains("name") && !r.string(j["name"], p / "name", &po.name)) return false;
+            if (!j.contains("cells")) return r.fail(p, "missing \"cells\": the two cells it joins, e.g. \"cells\": [\"hall\", \"kitchen\"]");
+            const Json &cj = j["cells"];
+            if (!cj.is_array() || cj.size() != 2)
+                return r.fail(p / "cells", "expected the names of the 2 cells it joins, got " +
+                                               (cj.is_array() ? "an array of " + std::to_string(cj.size()) : json::typeName(cj)));
+            for (size_t k = 0; k < 2; ++k) {
+                std::string n;
+                if (!r.string(cj[k], p / "cells" / k, &n)) return false;
+                auto it = cellIndex.find(n);
+                if (it == cellIndex.end()) {
+                    const std::string near = json::closest(n, names);
+                    return r.fail(p / "cells" / k, "cell '" + n + "' is not defined in \"cells\"" +
+                                                       (near.empty() ? "; defined: " + json::joinList(names) : "; did you mean '" + near + "'?"));
+                }
+                po.cells[k] = it->second;
+            }
+            if (po.cells[0] == po.cells[1])
+                return r.fail(p / "cells" / size_t(1), "a portal joins two different cells; both are '" + cells[po.cells[0]].name + "'");
+            if (!j.contains("points")) return r.fail(p, "missing \"points\": the portal polygon's corners in order (3 or more, coplanar, convex)");
+            const Json &pj = j["points"];
+            if (!pj.is_array() || pj.size() < 3)
+                return r.fail(p / "points", "expected an array of 3 or more points (the polygon's corners in order), got " +
+                                                (pj.is_array() ? "an array of " + std::to_string(pj.size()) : json::typeName(pj)));
+            for (size_t k = 0; k < pj.size(); ++k) {
+                Vec3 v;
+                if (!r.vec3(pj[k], p / "points" / k, &v)) return false;
+                po.points.push_back(v);
+            }
+            // Shape: non-zero area, flat and convex within kPortalFlatness of its size.
+            const size_t m = po.points.size();
+            Vec3 N{0, 0, 0}, c{0, 0, 0};
+            double size = 0;
+            for (size_t k = 0; k < m; ++k) {
+                const Vec3 &a = po.points[k], &b = po.points[(k + 1) % m];
+                N = N + cross(a, b);
+                c = c + a;
+                size = std::max(size, length(b - a));
+            }
+            c = c / double(m);
+            if (!(length(N) > kPortalFlatness * size * size))
+                return r.fail(p / "points", "the polygon has no area (its points are collinear or repeated)");
+            N = normalize(N);
+            for (size_t k = 0; k < m; ++k) {
+                const double off = std::fabs(dot(N, po.points[k] - c));
+                if (off > kPortalFlatness * size)
+                {
+                    char buf[96];
+                    std::snprintf(buf, sizeof buf, "is %g off the portal's plane; a portal is flat (points within %g of its size)", off,
+                                  kPortalFlatness);
+                    return r.fail(p / "points" / k, buf);
+                }
+                const Vec3 &a = po.points[k], &b = po.points[(k + 1) % m], &d = po.points[(k + 2) % m];
+                if (dot(N, cross(b - a, d - b)) < -kPortalFlatness * size * size)
+                    return r.fail(p / "points" / ((k + 1) % m), "bends the polygon inwards; a portal is convex (list its corners in order "
+                                                                "around it; split a concave opening into several portals)");
+            }
+            portals.push_back(std::move(po));
+        }
+    }
+    *cellsOut = std::move(cells);
+    *portalsOut = std::move(portals);
+    return true;
+}
+
 bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
     json::Doc doc;
     if (!json::parseFile(path, &doc, err)) return false;
@@ -204,7 +360,8 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
         *err = json::where(doc, top) + ": expected a JSON object with \"format\": \"" + kSceneFormat + "\", got " + json::typeName(root);
         return false;
     }
-    if (!r.checkKeys(root, top, {"format", "up", "materials", "objects", "lights", "views"})) return failed();
+    if (!r.checkKeys(root, top, {"format", "up", "materials", "objects", "lights", "views", "cells", "portals"}))
+        return failed();
     if (!root.contains("format")) {
         *err = json::where(doc, top) + ": missing \"format\": add \"format\": \"" + kSceneFormat + "\"";
         return false;
@@ -404,12 +561,20 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
     if (root.contains("views") && !r.views(root["views"], top / "views", upVector(in.up), "scene", &in.views))
         return failed();
 
+    std::vector<Cell> cells;
+    std::vector<Portal> portals;
+    if (!readCellsAndPortals(r, root, &cells, &portals)) return failed();
+
     Scene s;
     std::string e;
     if (!buildScene(std::move(in), opt.chunks, &s, &e)) {
         *err = path + ": " + e;
         return false;
     }
+    // Cells need the culling objects (chunks) to exist: each belongs to every cell it overlaps.
+    s.cells = std::move(cells);
+    s.portals = std::move(portals);
+    assignObjectsToCells(s);
     *out = std::move(s);
     return true;
 }

@@ -160,6 +160,30 @@ struct BspLevel {
     }
 };
 
+// ---- Cells and portals from a scene file (docs/scene-format.md, docs/coarse-stages.md) ----------
+
+// A half-space n.p + k >= 0 (the inside of a cell's face).
+struct HalfSpace {
+    Vec3 n;
+    double k = 0;
+};
+
+// A convex cell: the intersection of its half-spaces, closed (a point on a face is inside). Given
+// as a box ("min"/"max": six axis-aligned half-spaces, `box` holds it) or as planes ("planes":
+// [a, b, c, d] with a x + b y + c z + d >= 0 inside; `box` is then empty).
+struct Cell {
+    std::string name;
+    std::vector<HalfSpace> faces;
+    Aabb box;                          // the box of a "min"/"max" cell; empty for a "planes" cell
+};
+
+// A convex polygon (3+ coplanar points, in order) joining two cells; seen from either side.
+struct Portal {
+    std::string name;
+    uint32_t cells[2] = {0, 0};        // indices into Scene::cells
+    std::vector<Vec3> points;
+};
+
 struct SceneStats {
     uint64_t sourceTriangles = 0;     // triangles in source order (ids 0 .. n-1)
     uint64_t degenerateTriangles = 0; // zero area (two equal vertices or collinear): excluded
@@ -186,6 +210,13 @@ struct Scene {
     SceneStats stats;
     std::vector<std::string> warnings;    // loader notes: dropped faces, ignored glTF features, ...
     std::optional<BspLevel> bsp;          // Quake 3 maps: BSP tree, leafs, clusters, PVS, entities
+    // Cells and portals (scene files only; empty: none). Per culling object, the cells its bounds
+    // overlap: objectCells[objectCellsBegin[o] .. objectCellsBegin[o + 1]) (ascending; empty: in no
+    // cell, always kept). Filled by assignObjectsToCells (analysis/portals.h) once objects exist.
+    std::vector<Cell> cells;
+    std::vector<Portal> portals;
+    std::vector<uint32_t> objectCellsBegin;
+    std::vector<uint32_t> objectCells;
 
     size_t triangleCount() const { return triangleObject.size(); }
     const Material &materialOf(const SceneObject &o) const { return materials[o.material]; }
