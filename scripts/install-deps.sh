@@ -10,12 +10,16 @@ PACKAGES=(
   libtinygltf-dev libstb-dev libzip-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   parallel
+  chromium fonts-dejavu-core nodejs
 )
 
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm (the browser test's installer, scripts/test.sh) is a package of its own in Debian but comes
+# inside NodeSource's nodejs, which conflicts with Debian's npm: ask for it only when no npm runs.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi
