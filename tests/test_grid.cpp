@@ -4,7 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <random>
+
+#include "analysis/audit.h"
+#include "analysis/load.h"
 
 #include "analysis/demo.h"
 #include "analysis/frustum.h"  // worldFrustumPlanes
@@ -158,6 +163,46 @@ TEST(GridCull, CulledObjectsAreOutsideTheFrustum) {
         EXPECT_EQ(r.stats.cellsSkipped + r.stats.cellsEmpty + r.stats.cellsTested, r.stats.cellsTotal);
     }
     EXPECT_GT(culledTotal, 1000u);  // the test culls something worth checking
+}
+
+// The castle dungeon from orbit views and from its center: no false culls against the reference.
+TEST(GridScenes, CastleDungeonNoFalseCulls) {
+    const std::string path = std::string(VISAUDIT_TEST_DATA) + "/castle/level/level-dungeon.gltf";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "not fetched: " << path << " (scripts/fetch-data.sh)";
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadScene(path, {}, &s, &err)) << err;
+    const Grid g = buildGrid(s);
+    std::vector<ViewSpec> views = orbitViews(s, 4);
+    for (int k = 0; k < 4; ++k) {
+        ViewSpec v;
+        v.camera.eye = s.bounds.center();
+        v.camera.target = s.bounds.center() + Vec3{std::cos(k * kPi / 2), 0, std::sin(k * kPi / 2)};
+        v.camera.nearZ = 0.01;
+        v.camera.farZ = 1000;
+        views.push_back(v);
+    }
+    uint64_t culled = 0, in = 0, tested = 0, skipped = 0;
+    for (ViewSpec &v : views) {
+        v.camera.width = 320;
+        v.camera.height = 180;
+        const Camera cam = camera(v.camera);
+        const GridResult r = cullGrid(s, g, cam);
+        const ReferenceVisibility ref = referenceVisibility(s, cam);
+        std::vector<uint32_t> drawn;
+        for (uint32_t o : r.visible)
+            for (uint32_t i = s.objects[o].triBegin; i < s.objects[o].triEnd; ++i) drawn.push_back(s.objectTriangles[i]);
+        const CullAudit a = auditCulling(s, ref, {{"grid", r.culled, {}}}, drawn, nullptr);
+        EXPECT_EQ(a.stages[0].falseCullTriangles, 0u) << v.name;
+        culled += r.stats.objectsCulled;
+        in += r.stats.objectsIn;
+        tested += r.stats.cellsTested;
+        skipped += r.stats.cellsSkipped;
+    }
+    std::printf("[ grid ] dungeon: %d x %d x %d cells of %.3g, %zu views: objects culled %llu of %llu, cells tested %llu, skipped %llu\n",
+                g.dims[0], g.dims[1], g.dims[2], g.cellSize, views.size(), (unsigned long long)culled, (unsigned long long)in,
+                (unsigned long long)tested, (unsigned long long)skipped);
+    EXPECT_GT(culled, 0u);
 }
 
 TEST(GridSkip, Reasons) {

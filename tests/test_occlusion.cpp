@@ -236,5 +236,29 @@ TEST(OcclusionScenes, CastleDungeonNoFalseCulls) {
     expectNoFalseCulls(s, "dungeon");
 }
 
+// A Quake 3 map from its spawn points: walls everywhere, the case occlusion culling is for.
+TEST(OcclusionScenes, Q3dm6ishSpawnsNoFalseCulls) {
+    const std::string pk3 = std::string(VISAUDIT_TEST_DATA) + "/openarena/pak1-maps.pk3";
+    if (!std::filesystem::exists(pk3)) GTEST_SKIP() << "not fetched: " << pk3 << " (scripts/fetch-data.sh)";
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadScene(pk3 + ":maps/q3dm6ish.bsp", {}, &s, &err)) << err;
+    const ObjectBvh bvh = buildObjectBvh(s);
+    Audited total;
+    for (ViewSpec v : s.views) {
+        v.camera.width = 480;
+        v.camera.height = 270;
+        const Audited a = auditOcclusion(s, bvh, camera(v.camera));
+        EXPECT_EQ(a.falseCulls, 0u) << v.name;
+        total.culled += a.culled;
+        total.objectsIn += a.objectsIn;
+        total.trianglesCulled += a.trianglesCulled;
+    }
+    std::printf("[ occlusion ] q3dm6ish: %zu spawn views, objects culled %llu of %llu entering, triangles culled %llu, false culls 0\n",
+                s.views.size(), (unsigned long long)total.culled, (unsigned long long)total.objectsIn,
+                (unsigned long long)total.trianglesCulled);
+    EXPECT_GT(total.culled, 0u);
+}
+
 }  // namespace
 }  // namespace va
