@@ -97,6 +97,7 @@ async function checkScheme(colorScheme, screenshot) {
   const tag = `[${colorScheme}]`;
   const context = await browser.newContext({ viewport: { width: 1400, height: 1000 }, colorScheme });
   const page = await context.newPage();
+  page.setDefaultTimeout(10000);  // the page is local: anything slower is broken
   page.on('console', (m) => { if (m.type() === 'error') fail(`${tag} console error: ${m.text()}`); });
   page.on('pageerror', (e) => fail(`${tag} page error: ${e.message}`));
   page.on('requestfailed', (r) => fail(`${tag} request failed: ${r.url()} (${r.failure()?.errorText})`));
@@ -119,7 +120,8 @@ async function checkScheme(colorScheme, screenshot) {
     if (rows !== view.stages.length) fail(`${tag} view ${i}: funnel has ${rows} rows for ${view.stages.length} stages`);
     // A stage that ran draws a bar with a width proportional to its triangles_in.
     for (const st of view.stages.filter((s) => s.ran && s.triangles_in > 0)) {
-      const w = await funnel.locator(`g.stage[data-stage="${st.name}"] rect.in`).evaluate((r) => r.getBBox().width);
+      const bar = funnel.locator(`g.stage[data-stage="${st.name}"] rect.in`);
+      const w = (await bar.count()) === 1 ? await bar.evaluate((r) => r.getBBox().width) : 0;
       if (!(w > 1)) fail(`${tag} view ${i}: stage ${st.name} has no bar`);
     }
     // Every listed PNG is on the page.
