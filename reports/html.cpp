@@ -408,6 +408,9 @@ std::vector<const Json *> viewsOf(const Json &report) {
     return vs;
 }
 
+// Views whose images load with the page; later views' images load when scrolled near.
+constexpr size_t kEagerViews = 8;
+
 std::string viewId(size_t pos) { return "v" + std::to_string(pos); }
 
 // ---- SVG charts -----------------------------------------------------------------------------------
@@ -906,7 +909,9 @@ struct HtmlWriter {
     void planner();
     void depthAuditImage();
     void view(const Json *v, size_t pos);
-    void images(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
+    // eager: load with the page (the first views); else lazily, when scrolled near (reports of
+    // hundreds of views would otherwise load thousands of PNGs at once).
+    void images(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs, bool eager);
     void hotspots(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
     void falseCulls(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
     void raycast(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
@@ -1060,7 +1065,7 @@ void HtmlWriter::stageTable(const Json *v) {
     o += "</table></div></details>";
 }
 
-void HtmlWriter::images(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs) {
+void HtmlWriter::images(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs, bool eager) {
     if (imgs.empty()) {
         o += "<p class=\"note\">No images in the report folder for this view.</p>";
         return;
@@ -1069,7 +1074,7 @@ void HtmlWriter::images(const Json *v, const std::string &id, const std::vector<
     for (const ViewImage &im : imgs) {
         o += "<figure id=\"" + id + "-img-" + im.slug + "\"><a class=\"enlarge imgwrap\" href=\"" + urlOf(im.file) +
              "\" data-title=\"" + esc(im.title + " — " + im.file) + "\"><img src=\"" + urlOf(im.file) + "\" alt=\"" +
-             esc(im.title) + "\" loading=\"eager\"";
+             esc(im.title) + "\" loading=\"" + (eager ? "eager" : "lazy") + "\"";
         if (im.width > 0) o += " width=\"" + std::to_string(im.width) + "\" height=\"" + std::to_string(im.height) + "\"";
         o += ">";
         // Highlight boxes belong to the image they mark (see hotspots / raycast).
@@ -1384,7 +1389,7 @@ void HtmlWriter::view(const Json *v, size_t pos) {
 
     const std::vector<ViewImage> imgs = viewImages(v, folder);
     o += "<h3>Images</h3>";
-    images(v, id, imgs);
+    images(v, id, imgs, pos < kEagerViews);
     hotspots(v, id, imgs);
     falseCulls(v, id, imgs);
     raycast(v, id, imgs);

@@ -130,7 +130,11 @@ async function checkScheme(colorScheme, screenshot) {
       if (!srcs.includes(encodeURI(f)) && !srcs.includes(f)) fail(`${tag} view ${i}: image ${f} is not shown`);
   }
 
-  // Every image loaded.
+  // Every image loaded (lazily loaded ones of later views are made to load first).
+  await page.evaluate(() => Promise.all([...document.querySelectorAll('img[loading="lazy"]')].map((im) => {
+    im.loading = 'eager';
+    return im.complete ? null : new Promise((res) => { im.onload = im.onerror = res; });
+  })));
   const imgs = await page.locator('img').evaluateAll((all) =>
     all.filter((im) => im.closest('dialog') === null).map((im) => ({ src: im.getAttribute('src'), ok: im.complete && im.naturalWidth > 0,
                                                                         w: im.getBoundingClientRect().width })));
