@@ -2,14 +2,16 @@
 // Debian chromium through playwright-core (no browser download) and fails on anything a reader
 // would see broken.
 //
-//   node report.test.mjs --visaudit BUILD/visaudit --out DIR [--screenshot FILE.png]
-//       runs `visaudit analyze --out DIR --quiet` (the built-in demo), then tests DIR/report.html
+//   node report.test.mjs --visaudit BUILD/visaudit --out DIR [--views FILE] [--screenshot FILE.png]
+//       runs `visaudit analyze --out DIR --quiet` (the built-in demo; --views passed on), then
+//       tests DIR/report.html
 //   node report.test.mjs --report DIR [--screenshot FILE.png]
 //       tests an existing report folder
 //
 // Checks, in light and in dark color scheme:
 //   - no console error, no uncaught page error, no failed request, no request that is not file:
-//   - one section per view of report.json, a summary row per view;
+//   - one section per view of report.json, headed by the view's name as text (a name holding
+//     markup must not become markup, nor open an alert), a summary row per view;
 //   - per view a visible stage-funnel SVG with one row per stage of report.json;
 //   - every <img> loaded (complete, naturalWidth > 0), and every PNG report.json lists is shown;
 //   - a hotspot row's link outlines the hotspot's bbox on the z-fight image, at the right place;
@@ -58,7 +60,8 @@ if (args.visaudit) {
     process.exit(2);
   }
   dir = args.out;
-  execFileSync(args.visaudit, ['analyze', '--out', dir, '--quiet'], { stdio: 'inherit' });
+  execFileSync(args.visaudit, ['analyze', '--out', dir, '--quiet', ...(args.views ? ['--views', args.views] : [])],
+               { stdio: 'inherit' });
 }
 if (!dir) {
   console.error('give --visaudit BIN --out DIR or --report DIR');
@@ -101,6 +104,7 @@ async function checkScheme(colorScheme, screenshot) {
   page.on('console', (m) => { if (m.type() === 'error') fail(`${tag} console error: ${m.text()}`); });
   page.on('pageerror', (e) => fail(`${tag} page error: ${e.message}`));
   page.on('requestfailed', (r) => fail(`${tag} request failed: ${r.url()} (${r.failure()?.errorText})`));
+  page.on('dialog', (d) => { fail(`${tag} a script opened a ${d.type()} dialog: ${d.message()}`); d.dismiss(); });
   page.on('request', (r) => { if (!r.url().startsWith('file:')) fail(`${tag} network request: ${r.url()}`); });
   await page.goto(url, { waitUntil: 'load' });
 
@@ -112,6 +116,9 @@ async function checkScheme(colorScheme, screenshot) {
 
   for (let i = 0; i < report.views.length; ++i) {
     const view = report.views[i];
+    // The name shows as text, exactly as the report has it (markup in a name is not markup).
+    const title = await page.locator(`#v${i} > h2`).textContent();
+    if (title !== (view.name || '(unnamed view)')) fail(`${tag} view ${i}: heading ${JSON.stringify(title)} is not the name ${JSON.stringify(view.name)}`);
     // The funnel: visible, sized, one row per stage.
     const funnel = page.locator(`#v${i}-funnel`);
     const box = await funnel.boundingBox();
