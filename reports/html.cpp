@@ -1016,8 +1016,17 @@ void HtmlWriter::planner() {
     const Json *fx = get(&report, "effects");
     if (!fx || !fx->is_object()) return;
     o += "<section class=\"block\" id=\"planner\"><h2>Planner: what the scene calls for</h2>";
-    o += genericJson(fx);
-    o += "</section>";
+    // One line of decisions ("shadows: no (scene has no lights)"), the whole section folded below.
+    const Json *decisions = get(fx, "decisions");
+    std::string line;
+    if (decisions && decisions->is_array())
+        for (const Json &d : *decisions) {
+            const std::string reason = str(get(&d, "reason"));
+            line += (line.empty() ? "" : " · ") + std::string("<b>") + esc(str(get(&d, "name"))) + "</b>: " +
+                    (isTrue(get(&d, "ran")) ? "runs" : "does not run") + (reason.empty() ? "" : " (" + esc(reason) + ")");
+        }
+    if (!line.empty()) o += "<p id=\"planner-decisions\">" + line + "</p>";
+    o += "<details><summary>all values</summary>" + genericJson(fx) + "</details></section>";
 }
 
 void HtmlWriter::depthAuditImage() {

@@ -244,7 +244,9 @@ TEST(Html, SixQuestionsAnswerFromTheSectionsPresent) {
     // The planner's reason when no shadow rays ran.
     Json r = makeReport({makeView("p", 0, 0, 0, 1.0)});
     r["effects"] = {{"decisions", {{{"name", "shadows"}, {"ran", false}, {"reason", "scene has no lights"}}}}};
-    EXPECT_NE(va::reportHtml(r, "").find("not analysed</span> (scene has no lights)"), std::string::npos);
+    const std::string planned = va::reportHtml(r, "");
+    EXPECT_NE(planned.find("not analysed</span> (scene has no lights)"), std::string::npos);
+    EXPECT_NE(planned.find("<b>shadows</b>: does not run (scene has no lights)"), std::string::npos);
 }
 
 // An unknown section of a view is shown by its key as a table, not dropped.
