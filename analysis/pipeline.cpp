@@ -45,6 +45,7 @@ PreparedScene prepareScene(const Scene &scene) {
 bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err) {
     PreparedScene ps = prepareScene(scene);
     ps.effects = planEffects(scene, s.effects);
+    if (s.grid && !gridSkipReason(scene)) ps.grid = buildGrid(scene, s.gridSettings);
     if (s.raycast) {
         const auto t0 = Clock::now();
         ps.rays = std::make_unique<RayScene>();
@@ -104,26 +105,59 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         return out;
     };
 
-    // Coarse stage: cells (a map's PVS) where the scene has them.
+    // Coarse stage: cells where the scene has them (portals from the scene file, or a map's PVS),
+    // the grid otherwise.
+    const bool hasPortals = !portalsSkipReason(scene), hasPvs = !cellsSkipReason(scene);
     {
-        const char *why = cellsSkipReason(scene);
-        if (!why && !s.cells) why = "turned off by --no-cells";
-        if (why) {
-            r.stages.push_back(skipped("cells", why));
+        StageRecord st;
+        st.name = "cells";
+        if (!hasPortals && !hasPvs) {
+            r.stages.push_back(skipped("cells", "scene has no cells, portals or PVS"));
+        } else if (!s.cells) {
+            r.stages.push_back(skipped("cells", "turned off by --no-cells"));
         } else {
-            StageRecord st;
-            st.name = "cells";
             const auto t0 = Clock::now();
-            CellsResult c = cullCells(scene, cam);
+            st.trianglesIn = trianglesOf(scene, objects);
+            std::vector<uint32_t> visible;
+            if (hasPortals) {
+                PortalResult p = cullPortals(scene, cam, s.portals);
+                r.cellsArePortals = true;
+                r.portals = p.stats;
+                r.cellsNote = p.note;
+                visible = std::move(p.visible);
+            } else {
+                CellsResult c = cullCells(scene, cam);
+                r.cells = c.stats;
+                r.cellsNote = c.note;
+                visible = std::move(c.visible);
+            }
+            st.ms = msSince(t0);
+            st.ran = true;
+            if (s.audit) culls.push_back({"cells", removed(objects, visible), {}});
+            objects = std::move(visible);
+            st.trianglesOut = trianglesOf(scene, objects);
+            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
+            r.stages.push_back(st);
+        }
+    }
+    {
+        StageRecord st;
+        st.name = "grid";
+        if (const char *why = gridSkipReason(scene)) {
+            r.stages.push_back(skipped("grid", why));
+        } else if (!s.grid) {
+            r.stages.push_back(skipped("grid", "turned off by --no-grid"));
+        } else {
+            const auto t0 = Clock::now();
+            GridResult g = cullGrid(scene, ps.grid, cam, &objects);
             st.ms = msSince(t0);
             st.ran = true;
             st.trianglesIn = trianglesOf(scene, objects);
-            if (s.audit) culls.push_back({"cells", removed(objects, c.visible), {}});
-            objects = std::move(c.visible);
+            if (s.audit) culls.push_back({"grid", g.culled, {}});
+            objects = std::move(g.visible);
             st.trianglesOut = trianglesOf(scene, objects);
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-            r.cells = c.stats;
-            r.cellsNote = c.note;
+            r.grid = g.stats;
             r.stages.push_back(st);
         }
     }
@@ -146,6 +180,26 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             r.stages.push_back(st);
         } else {
             r.stages.push_back(skipped("frustum", "turned off by --no-frustum"));
+        }
+    }
+
+    // Occlusion: a depth pre-pass of the best occluders, a max-depth pyramid, conservative box tests.
+    {
+        StageRecord st;
+        st.name = "occlusion";
+        if (s.occlusion) {
+            OcclusionResult oc = cullOcclusion(scene, cam, objects, s.occlusionSettings);
+            st.ran = true;
+            st.ms = oc.stats.prepassMs + oc.stats.testMs;
+            st.trianglesIn = trianglesOf(scene, objects);
+            if (s.audit) culls.push_back({"occlusion", oc.culled, {}});
+            objects = std::move(oc.visible);
+            st.trianglesOut = trianglesOf(scene, objects);
+            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
+            r.occlusion = oc.stats;
+            r.stages.push_back(st);
+        } else {
+            r.stages.push_back(skipped("occlusion", "turned off by --no-occlusion"));
         }
     }
 
@@ -207,7 +261,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         ZBufferSettings zs;
         zs.encoder = makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ);
         zs.orthographic = cam.orthographic;
-        if (s.audit) {
+        if (s.audit || s.detail) {
             fragmentsPerSource.assign(scene.triangleCount(), 0);
             zs.fragmentsPerSource = fragmentsPerSource.data();
         }
@@ -270,6 +324,12 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         r.auditRan = true;
     } else {
         r.auditReason = "turned off by --no-audit";
+    }
+
+    // Audit: detail -- triangles drawn against the pixels they show, too small, over-detailed.
+    if (s.detail) {
+        r.detail = auditDetail(scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
+        r.detailRan = true;
     }
 
     // Audit: z-fighting of the two nearest surfaces per pixel, in every depth format, over exactly

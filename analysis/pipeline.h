@@ -12,6 +12,10 @@
 #include "analysis/results.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
+#include "analysis/detail.h"
+#include "analysis/grid.h"
+#include "analysis/occlusion.h"
+#include "analysis/portals.h"
 #include "analysis/effects_plan.h"
 #include "render/raycast.h"
 #include "render/clip.h"
@@ -25,7 +29,14 @@ struct Limits {
 
 struct PipelineSettings {
     bool cells = true;     // --no-cells turns the stage off (where the scene has cells or a PVS)
+    bool grid = true;      // --no-grid turns the stage off (scenes without cells)
+    GridSettings gridSettings;          // --grid-cell
+    PortalSettings portals;             // --portal-depth
     bool frustum = true;   // --no-frustum turns the stage off
+    bool occlusion = true; // --no-occlusion turns the stage off
+    OcclusionSettings occlusionSettings; // --occluders
+    bool detail = true;    // --no-detail turns the detail audit off
+    DetailSettings detailSettings;      // --detail-min-pixels, --detail-triangles-per-pixel
     bool backface = true;  // --no-backface turns the stage off
     int width = 0, height = 0;                 // > 0: override every view's resolution
     std::optional<DepthFormat> depthFormat;    // override every view's depth format
@@ -43,6 +54,7 @@ struct PipelineSettings {
 struct PreparedScene {
     const Scene *scene = nullptr;
     ObjectBvh bvh;
+    Grid grid;                       // when the grid stage can run (gridSkipReason is null)
     std::unique_ptr<RayScene> rays;  // Embree scene over every analysed triangle (raycast on)
     double raySceneBuildMs = 0;
     SceneEffectsData effectsData;

@@ -10,6 +10,10 @@
 
 #include "analysis/audit.h"
 #include "analysis/cells.h"
+#include "analysis/detail.h"
+#include "analysis/grid.h"
+#include "analysis/occlusion.h"
+#include "analysis/portals.h"
 #include "analysis/effects_plan.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
@@ -60,7 +64,13 @@ struct ViewResult {
     ZBufferStats zbuffer;
     ZBuffer buffer;                   // per-pixel buffers, for the images (may be released after writing)
     CellsStats cells;                 // the cells stage (PVS), when it ran
+    bool cellsArePortals = false;     // the cells stage traversed the scene's portals (not a PVS)
+    PortalStats portals;              // the cells stage (portals), when it ran
     std::string cellsNote;            // e.g. the camera is in the void
+    GridStats grid;                   // the grid stage, when it ran
+    OcclusionStats occlusion;         // the occlusion stage, when it ran
+    bool detailRan = false;           // the detail audit (docs/coarse-stages.md)
+    DetailResult detail;
     // The raycast stage: Embree primary rays at pixel centers over the whole scene (no culling),
     // cross-checked pixel by pixel against the z-buffer; secondary rays where the plan says.
     bool raycastRan = false;

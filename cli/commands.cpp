@@ -30,6 +30,7 @@
 #include "reports/depth_plot.h"
 #include "reports/budget.h"
 #include "reports/grade.h"
+#include "reports/html.h"
 #include "reports/merge.h"
 #include "reports/report.h"
 
@@ -48,6 +49,9 @@ struct Options {
     uint32_t chunk = 512;
     bool noBackface = false, noFrustum = false, noZFight = false, noAudit = false, noCells = false, noRaycast = false;
     int patchLevel = 5;
+    bool noGrid = false, noOcclusion = false, noDetail = false;
+    double gridCell = 0, detailMinPixels = 4, detailTrianglesPerPixel = 1;
+    uint32_t occluders = 16, portalDepth = 64;
     // Effects: unset = the scene decides.
     std::optional<bool> shadows, reflections, refractions, abuffer;
     int maxDepth = 4;
@@ -118,6 +122,14 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->zfight = !o.noZFight;
     s->audit = !o.noAudit;
     s->cells = !o.noCells;
+    s->grid = !o.noGrid;
+    s->gridSettings.cellSize = o.gridCell;
+    s->portals.maxDepth = o.portalDepth;
+    s->occlusion = !o.noOcclusion;
+    s->occlusionSettings.maxOccluders = o.occluders;
+    s->detail = !o.noDetail;
+    s->detailSettings.minPixels = o.detailMinPixels;
+    s->detailSettings.trianglesPerPixel = o.detailTrianglesPerPixel;
     s->raycast = !o.noRaycast;
     s->effects.shadows = o.shadows;
     s->effects.reflections = o.reflections;
@@ -263,7 +275,7 @@ int analyzeToReport(const Options &o,
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was.
     if (!writeFileAtomic(out.staging() + "/report.json", report->dump(2) + "\n", &err) ||
-        !out.commit(&err)) {
+        !writeReportHtml(*report, out.staging(), &err) || !out.commit(&err)) {
         fail(err);
         return kExitBadInput;
     }
@@ -412,7 +424,8 @@ int cmdMerge(const Options &o) {
         fail(err);
         return kExitBadInput;
     }
-    if (!writeFileAtomic(out.staging() + "/report.json", merged.dump(2) + "\n", &err) || !out.commit(&err)) {
+    if (!writeFileAtomic(out.staging() + "/report.json", merged.dump(2) + "\n", &err) ||
+        !writeReportHtml(merged, out.staging(), &err) || !out.commit(&err)) {
         fail(err);
         return kExitBadInput;
     }
@@ -505,6 +518,19 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-zfight", o.noZFight, "Turn the z-fighting analysis off");
     c->add_flag("--no-audit", o.noAudit, "Turn the reference-visibility audit (false culls, wasted draws) off");
     c->add_flag("--no-cells", o.noCells, "Turn the cells stage (a map's PVS, portals) off");
+    c->add_flag("--no-grid", o.noGrid, "Turn the grid stage (scenes without cells) off");
+    c->add_option("--grid-cell", o.gridCell, "Grid cell size in world units (0 = about one cell per 8 objects)")
+        ->check(CLI::Range(0.0, 1e30));
+    c->add_option("--portal-depth", o.portalDepth, "Most portals along one path of the portal traversal")
+        ->check(CLI::Range(1u, 100000u));
+    c->add_flag("--no-occlusion", o.noOcclusion, "Turn the occlusion stage off");
+    c->add_option("--occluders", o.occluders, "Occluders drawn in the occlusion pre-pass")->check(CLI::Range(0u, 100000u));
+    c->add_flag("--no-detail", o.noDetail, "Turn the detail audit off");
+    c->add_option("--detail-min-pixels", o.detailMinPixels, "Detail audit: objects projected smaller are too small")
+        ->check(CLI::Range(0.0, 1e9));
+    c->add_option("--detail-triangles-per-pixel", o.detailTrianglesPerPixel,
+                  "Detail audit: more triangles than visible pixels times this is over-detailed")
+        ->check(CLI::Range(1e-9, 1e9));
     c->add_flag("--no-raycast", o.noRaycast, "Turn the raycast stage (Embree cross-check, secondary rays) off");
     // Effects: the scene decides (lights, reflective, refractive, transparent materials); a flag forces.
     auto effect = [&](const char *on, const char *off, std::optional<bool> &v, const char *what) {

@@ -158,6 +158,90 @@ Json cellsJson(const CellsStats &c, const std::string &note) {
     return j;
 }
 
+Json portalsJson(const PortalStats &p, const std::string &note) {
+    Json j;
+    j["camera_cell"] = p.cameraCell;
+    j["camera_cells"] = p.cameraCells;
+    j["camera_outside"] = p.cameraOutside;
+    j["cells_visible"] = p.cellsVisible;
+    j["cells_total"] = p.cellsTotal;
+    j["cells_visited"] = p.cellsVisited;
+    j["portals_tested"] = p.portalsTested;
+    j["portals_passed"] = p.portalsPassed;
+    j["portals_edge_on"] = p.portalsEdgeOn;
+    j["portals_in_portal"] = p.portalsInPortal;
+    j["depth_limit_hits"] = p.depthLimitHits;
+    j["budget_exceeded"] = p.budgetExceeded;
+    j["objects_in"] = p.objectsIn;
+    j["objects_culled"] = p.objectsCulled;
+    j["objects_no_cell"] = p.objectsNoCell;
+    j["note"] = note;
+    return j;
+}
+
+Json gridJson(const GridStats &g) {
+    Json j;
+    j["dims"] = {g.dims[0], g.dims[1], g.dims[2]};
+    j["cell_size"] = num(g.cellSize);
+    j["cells_total"] = g.cellsTotal;
+    j["registrations"] = g.registrations;
+    j["cells_skipped"] = g.cellsSkipped;
+    j["cells_empty"] = g.cellsEmpty;
+    j["cells_tested"] = g.cellsTested;
+    j["cells_visible"] = g.cellsVisible;
+    j["plane_tests"] = g.planeTests;
+    j["objects_in"] = g.objectsIn;
+    j["objects_culled"] = g.objectsCulled;
+    return j;
+}
+
+Json occlusionJson(const OcclusionStats &o) {
+    Json j;
+    j["occluders_used"] = o.occludersUsed;
+    j["occluder_triangles"] = o.occluderTriangles;
+    j["prepass_fragments"] = o.prepassFragments;
+    j["prepass_pixels"] = o.prepassPixels;
+    j["hiz_levels"] = o.hizLevels;
+    j["objects_in"] = o.objectsIn;
+    j["objects_tested"] = o.objectsTested;
+    j["objects_culled"] = o.objectsCulled;
+    j["objects_hidden"] = o.objectsHidden;
+    j["objects_no_pixel"] = o.objectsNoPixel;
+    j["objects_near_plane"] = o.objectsNearPlane;
+    j["texels_read"] = o.texelsRead;
+    j["prepass_ms"] = num(o.prepassMs);
+    j["test_ms"] = num(o.testMs);
+    return j;
+}
+
+Json detailJson(const DetailResult &d) {
+    Json j;
+    j["ran"] = true;
+    j["objects_drawn"] = d.objectsDrawn;
+    j["triangles_drawn"] = d.trianglesDrawn;
+    j["triangles_no_center"] = d.trianglesNoCenter;
+    j["pixels_visible"] = d.pixelsVisible;
+    j["triangles_per_visible_pixel"] = num(d.trianglesPerVisiblePixel);
+    j["objects_too_small"] = d.objectsTooSmall;
+    j["objects_over_detailed"] = d.objectsOverDetailed;
+    j["triangles_savable"] = d.trianglesSavable;
+    Json flagged = Json::array();
+    for (const DetailObject &o : d.flagged)
+        flagged.push_back({{"object", o.object},
+                           {"name", o.name},
+                           {"triangles_drawn", o.trianglesDrawn},
+                           {"triangles_no_center", o.trianglesNoCenter},
+                           {"fragments", o.fragments},
+                           {"pixels_visible", o.pixelsVisible},
+                           {"projected_pixels", num(o.projectedPixels)},
+                           {"too_small", o.tooSmall},
+                           {"over_detailed", o.overDetailed},
+                           {"triangles_saved", o.trianglesSaved}});
+    j["flagged"] = flagged;
+    j["ms"] = num(d.ms);
+    return j;
+}
+
 Json raycastStageJson(const RaycastStats &r) {
     return {{"rays", r.rays}, {"hits", r.hits}, {"packets", r.packets}};
 }
@@ -224,7 +308,9 @@ Json stageJson(const StageRecord &s, const ViewResult &v) {
         else if (s.name == "backface") own = backfaceJson(v.backface);
         else if (s.name == "clip") own = clipJson(v.clip);
         else if (s.name == "zbuffer") own = zbufferStageJson(v.zbuffer);
-        else if (s.name == "cells") own = cellsJson(v.cells, v.cellsNote);
+        else if (s.name == "cells") own = v.cellsArePortals ? portalsJson(v.portals, v.cellsNote) : cellsJson(v.cells, v.cellsNote);
+        else if (s.name == "grid") own = gridJson(v.grid);
+        else if (s.name == "occlusion") own = occlusionJson(v.occlusion);
         else if (s.name == "raycast") own = raycastStageJson(v.raycast);
         for (auto it = own.begin(); it != own.end(); ++it) j[it.key()] = it.value();
     }
@@ -426,6 +512,10 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
             vj["raycast"] = raycastJson(v, r.lightNames);
         else
             vj["raycast"] = {{"ran", false}, {"reason", "turned off by --no-raycast"}};
+        if (v.detailRan)
+            vj["detail"] = detailJson(v.detail);
+        else
+            vj["detail"] = {{"ran", false}, {"reason", "turned off by --no-detail"}};
         if (v.auditRan)
             vj["audit"] = auditJson(v);
         else

@@ -316,7 +316,7 @@ TEST(LoadScene, FormatKeyAndUnknownKeys) {
                   "alpha, reflective, ior)");
     EXPECT_EQ(sceneError("{ \"format\": \"visaudit-scene/1\", \"object\": [] }"),
               f + ":1:33: unknown key 'object' at the top level; did you mean 'objects'? (known keys: format, up, "
-                  "materials, objects, lights, views)");
+                  "materials, objects, lights, views, cells, portals)");
 }
 
 TEST(LoadScene, WrongTypes) {

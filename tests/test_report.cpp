@@ -335,7 +335,9 @@ TEST(ReportJson, ExactValues) {
     EXPECT_EQ(st[0].dump(),
               R"({"name":"cells","ran":false,"reason":"scene has no cells","triangles_in":0,"triangles_culled":0,"triangles_out":0,"ms":0.0})");
     EXPECT_EQ(st[1].dump(),
-              R"({"name":"grid","ran":true,"triangles_in":1200,"triangles_culled":200,"triangles_out":1000,"ms":0.04})");
+              R"({"name":"grid","ran":true,"triangles_in":1200,"triangles_culled":200,"triangles_out":1000,"ms":0.04,)"
+              R"("dims":[0,0,0],"cell_size":0.0,"cells_total":0,"registrations":0,"cells_skipped":0,"cells_empty":0,)"
+              R"("cells_tested":0,"cells_visible":0,"plane_tests":0,"objects_in":0,"objects_culled":0})");
     EXPECT_EQ(st[2].dump(),
               R"({"name":"frustum","ran":true,"triangles_in":1000,"triangles_culled":400,"triangles_out":600,"ms":0.25,)"
               R"("objects_in":40,"objects_culled":16,"objects_inside":20,"objects_intersecting":4,"nodes_visited":31,)"
