@@ -1,0 +1,504 @@
+// Draw order and exact order (ordering.h; docs/ordering.md).
+#include "analysis/ordering.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "render/clip.h"
+#include "render/raster_core.h"
+
+namespace va {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+Vec3 vertexOf(const Scene &s, uint32_t t, int i) { return s.positions[s.indices[3 * size_t(t) + i]]; }
+
+// View depth d = -z_view of a world point (perspective and orthographic alike).
+double viewDepth(const Camera &cam, Vec3 p) { return dot(p - cam.eye, cam.forward); }
+
+const DepthPlane &planeOfSource(const OrderingView &v, uint32_t s) { return v.all.planes[v.all.plane[v.screenBegin[s]]]; }
+
+// Signed area (twice, fixed point) of screen triangle t: < 0 is the front winding (raster_core.h).
+int64_t screenArea(const ScreenTriangles &st, size_t t) {
+    const int32_t *p = st.xy.data() + 6 * t;
+    return (int64_t(p[2]) - p[0]) * (int64_t(p[5]) - p[1]) - (int64_t(p[3]) - p[1]) * (int64_t(p[4]) - p[0]);
+}
+
+// The drawing sink: optional depth test (LESS on the double depth), optional piece filter.
+struct OrderSink {
+    const OrderingView &v;
+    const std::vector<uint32_t> &itemOf;  // per screen triangle of the draw list: its item
+    const std::vector<DrawItem> &items;
+    const BspTree *tree;
+    const BspViewPlanes *planes;
+    bool depthTest;
+    std::vector<double> &depth;
+    std::vector<uint32_t> &id;
+    uint32_t current = 0;
+    uint32_t piece = UINT32_MAX;
+    uint64_t fragments = 0, passes = 0;
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const DrawItem &it = items[itemOf[t]];
+        if (v.singleSided[it.source] && !frontWinding) return false;
+        current = it.source + 1;
+        piece = (it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount) ? it.piece : UINT32_MAX;
+        return true;
+    }
+    void fragment(size_t i, size_t, double d) {
+        if (piece != UINT32_MAX) {
+            // The surface point at the pixel center: on the ray through it at view depth d.
+            const size_t x = i % size_t(v.cam.width), y = i / size_t(v.cam.width);
+            const ViewRay r = viewRayThroughPixel(v.cam, double(x) + 0.5, double(y) + 0.5);
+            if (!bspPieceContains(*tree, *planes, piece, r.origin + r.direction * d)) return;
+        }
+        ++fragments;
+        if (!depthTest) {
+            id[i] = current;
+            ++passes;
+        } else if (d < depth[i]) {
+            depth[i] = d;
+            id[i] = current;
+            ++passes;
+        }
+    }
+    void endTriangle(size_t, uint64_t) {}
+};
+
+}  // namespace
+
+OrderingView prepareOrderingView(const Scene &scene, const Camera &cam) {
+    const auto t0 = Clock::now();
+    OrderingView v;
+    v.scene = &scene;
+    v.cam = cam;
+    std::vector<ClipBatch> batches;
+    for (const SceneObject &o : scene.objects)
+        if (o.triEnd > o.triBegin)
+            batches.push_back({o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
+    v.all = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    v.screenBegin.assign(scene.triangleCount(), 0);
+    v.screenEnd.assign(scene.triangleCount(), 0);
+    // The clipper emits a source's fan pieces consecutively.
+    for (size_t t = 0; t < v.all.size(); ++t) {
+        const uint32_t s = v.all.source[t];
+        if (v.screenEnd[s] == v.screenBegin[s]) v.screenBegin[s] = uint32_t(t);
+        v.screenEnd[s] = uint32_t(t + 1);
+    }
+    v.singleSided = singleSidedTriangles(scene);
+    v.clipMs = msSince(t0);
+    return v;
+}
+
+PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
+                                     const std::vector<uint32_t> &ids) {
+    PixelComparison c;
+    c.cls.assign(ids.size(), kOrderRight);
+    const size_t w = size_t(std::max(v.cam.width, 1));
+    for (size_t p = 0; p < ids.size() && p < ref.id.size(); ++p) {
+        const uint32_t a = ids[p], b = ref.id[p];
+        if (a == b) continue;
+        const double px = double(p % w) + 0.5, py = double(p / w) + 0.5;
+        if (a && b &&
+            viewDepthAt(v.cam, planeOfSource(v, a - 1), px, py) == viewDepthAt(v.cam, planeOfSource(v, b - 1), px, py)) {
+            c.cls[p] = kOrderTie;
+            ++c.tiePixels;
+            continue;
+        }
+        // Within the coverage uncertainty of either triangle's boundary (the float frame of the
+        // edge bound at the eye: the rasterizer's snapping dominates).
+        const bool edge = (a && edgeDistance(*v.scene, v.cam, v.cam.eye, a - 1, px, py).nearEdge) ||
+                          (b && edgeDistance(*v.scene, v.cam, v.cam.eye, b - 1, px, py).nearEdge);
+        c.cls[p] = edge ? kOrderEdge : kOrderWrong;
+        (edge ? c.edgePixels : c.wrongPixels)++;
+    }
+    return c;
+}
+
+const char *painterKeyName(PainterKey k) {
+    switch (k) {
+        case PainterKey::centroid: return "centroid";
+        case PainterKey::nearestVertex: return "nearest_vertex";
+        case PainterKey::farthestVertex: return "farthest_vertex";
+    }
+    return "?";
+}
+
+std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
+    const Scene &scene = *v.scene;
+    std::vector<std::pair<double, uint32_t>> keyed;
+    for (uint32_t s = 0; s < scene.triangleCount(); ++s) {
+        if (v.screenEnd[s] == v.screenBegin[s]) continue;
+        const double d0 = viewDepth(v.cam, vertexOf(scene, s, 0)), d1 = viewDepth(v.cam, vertexOf(scene, s, 1)),
+                     d2 = viewDepth(v.cam, vertexOf(scene, s, 2));
+        double k = 0;
+        switch (key) {
+            case PainterKey::centroid: k = (d0 + d1 + d2) / 3; break;  // depth is affine: the centroid's depth
+            case PainterKey::nearestVertex: k = std::min(d0, std::min(d1, d2)); break;
+            case PainterKey::farthestVertex: k = std::max(d0, std::max(d1, d2)); break;
+        }
+        keyed.push_back({k, s});
+    }
+    // Back to front: largest key first; equal keys by descending id, so the lowest id is drawn
+    // last and shows (the reference's tie rule).
+    std::sort(keyed.begin(), keyed.end(), [](const auto &a, const auto &b) {
+        return a.first > b.first || (a.first == b.first && a.second > b.second);
+    });
+    std::vector<uint32_t> order(keyed.size());
+    for (size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
+    return order;
+}
+
+DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest, const BspTree *tree,
+                      const BspViewPlanes *planes, std::vector<uint32_t> *idsOut) {
+    const auto t0 = Clock::now();
+    DrawStats st;
+    // The draw list: each item's screen triangles, in item order (depth planes shared with `all`).
+    ScreenTriangles list;
+    std::vector<uint32_t> itemOf;
+    list.planes = v.all.planes;
+    for (size_t k = 0; k < items.size(); ++k) {
+        const uint32_t s = items[k].source;
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t) {
+            list.xy.insert(list.xy.end(), v.all.xy.begin() + 6 * size_t(t), v.all.xy.begin() + 6 * size_t(t) + 6);
+            list.source.push_back(s);
+            list.plane.push_back(v.all.plane[t]);
+            itemOf.push_back(uint32_t(k));
+        }
+    }
+    const size_t pixels = size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0));
+    std::vector<double> depth(depthTest ? pixels : 0, std::numeric_limits<double>::infinity());
+    std::vector<uint32_t> id(pixels, 0);
+    OrderSink sink{v, itemOf, items, tree, planes, depthTest, depth, id};
+    forEachFragment(list, v.cam.width, v.cam.height, v.cam.orthographic, sink);
+    st.fragments = sink.fragments;
+    st.depthPasses = sink.passes;
+    for (uint32_t i : id) st.coveredPixels += i != 0;
+    st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+    st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+    st.ms = msSince(t0);
+    if (idsOut) *idsOut = std::move(id);
+    return st;
+}
+
+// ---- Painter's overlap tests --------------------------------------------------------------------
+
+namespace {
+
+struct PairTri {
+    double zmin, zmax;            // view depth range over its clipped screen vertices
+    double bx0, by0, bx1, by1;    // screen bounding rectangle (pixels)
+    uint32_t src, rank;           // rank: position in the painter's order (lower = drawn first)
+};
+
+// Projections disjoint: every screen triangle of a against every one of b separated by one of the
+// six edge normals (integer fixed point, exact in int64: |coordinate| <= 2^29 by the core's range,
+// normals below 2^31, dot products below 2^61). Touching (max == min) counts as separated.
+bool projectionsDisjoint(const ScreenTriangles &st, uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1) {
+    auto separated = [&](const int32_t *A, const int32_t *B) {
+        const int32_t *T[2] = {A, B};
+        for (int w = 0; w < 2; ++w)
+            for (int e = 0; e < 3; ++e) {
+                const int32_t *p = T[w];
+                const int64_t nx = -(int64_t(p[2 * ((e + 1) % 3) + 1]) - p[2 * e + 1]);
+                const int64_t ny = int64_t(p[2 * ((e + 1) % 3)]) - p[2 * e];
+                int64_t minA = INT64_MAX, maxA = INT64_MIN, minB = INT64_MAX, maxB = INT64_MIN;
+                for (int i = 0; i < 3; ++i) {
+                    const int64_t pa = nx * A[2 * i] + ny * A[2 * i + 1], pb = nx * B[2 * i] + ny * B[2 * i + 1];
+                    minA = std::min(minA, pa), maxA = std::max(maxA, pa);
+                    minB = std::min(minB, pb), maxB = std::max(maxB, pb);
+                }
+                if (maxA <= minB || maxB <= minA) return true;
+            }
+        return false;
+    };
+    for (uint32_t a = a0; a < a1; ++a)
+        for (uint32_t b = b0; b < b1; ++b)
+            if (!separated(st.xy.data() + 6 * size_t(a), st.xy.data() + 6 * size_t(b))) return false;
+    return true;
+}
+
+// Every vertex of triangle p on Q's plane or on the side `side` of it (side = +-1: the eye's side,
+// or the side away from it); false when the eye is in Q's plane (side 0).
+bool allOnSide(const Scene &s, uint32_t q, uint32_t p, int side) {
+    if (side == 0) return false;
+    const Vec3 a = vertexOf(s, q, 0), b = vertexOf(s, q, 1), c = vertexOf(s, q, 2);
+    for (int i = 0; i < 3; ++i)
+        if (orient3d(a, b, c, vertexOf(s, p, i)) * side < 0) return false;
+    return true;
+}
+
+int eyeSide(const Scene &s, const Camera &cam, uint32_t q) {
+    const Vec3 a = vertexOf(s, q, 0), b = vertexOf(s, q, 1), c = vertexOf(s, q, 2);
+    if (!cam.orthographic) return orient3d(a, b, c, cam.eye);
+    const double v = -dot(cross(b - a, c - a), cam.forward);
+    return v > 0 ? 1 : (v < 0 ? -1 : 0);
+}
+
+}  // namespace
+
+OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
+    const auto t0 = Clock::now();
+    OverlapTests r;
+    const Scene &scene = *v.scene;
+    const std::vector<uint32_t> order = painterOrder(v, key);
+    std::vector<PairTri> tris;
+    for (uint32_t rank = 0; rank < order.size(); ++rank) {
+        const uint32_t s = order[rank];
+        // Drawn: some screen triangle with nonzero area, and the front winding when single-sided.
+        bool drawn = false;
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t) {
+            const int64_t a = screenArea(v.all, t);
+            drawn = drawn || (a != 0 && (!v.singleSided[s] || a < 0));
+        }
+        if (!drawn) continue;
+        PairTri p{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                  std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                  -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), s, rank};
+        const DepthPlane &pl = planeOfSource(v, s);
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
+            for (int i = 0; i < 3; ++i) {
+                const double px = double(v.all.xy[6 * size_t(t) + 2 * i]) / kSubpixelOne;
+                const double py = double(v.all.xy[6 * size_t(t) + 2 * i + 1]) / kSubpixelOne;
+                const double d = viewDepthAt(v.cam, pl, px, py);
+                p.zmin = std::min(p.zmin, d), p.zmax = std::max(p.zmax, d);
+                p.bx0 = std::min(p.bx0, px), p.bx1 = std::max(p.bx1, px);
+                p.by0 = std::min(p.by0, py), p.by1 = std::max(p.by1, py);
+            }
+        tris.push_back(p);
+    }
+    const size_t n = tris.size();
+    r.trianglesTested = n;
+
+    // Pairs whose closed depth ranges overlap: all pairs minus those with a entirely nearer than b
+    // (a.zmax < b.zmin), counted with a binary search over the sorted zmin.
+    std::vector<double> zmins(n);
+    for (size_t i = 0; i < n; ++i) zmins[i] = tris[i].zmin;
+    std::sort(zmins.begin(), zmins.end());
+    uint64_t disjoint = 0;
+    for (const PairTri &t : tris) disjoint += uint64_t(zmins.end() - std::upper_bound(zmins.begin(), zmins.end(), t.zmax));
+    r.pairs = uint64_t(n) * (n - (n > 0)) / 2 - disjoint;
+
+    // Pairs whose bounding rectangles overlap too, enumerated per 32-pixel screen tile: a pair is
+    // handled in the tile holding the lower-right-most of the two rectangles' top-left corners
+    // (inside both rectangles; tile indices clamped to the grid, which keeps that true), so once.
+    constexpr double kTile = 32;
+    const int ntx = std::max(1, (v.cam.width + 31) / 32), nty = std::max(1, (v.cam.height + 31) / 32);
+    auto tileX = [&](double x) { return std::clamp(int(std::floor(x / kTile)), 0, ntx - 1); };
+    auto tileY = [&](double y) { return std::clamp(int(std::floor(y / kTile)), 0, nty - 1); };
+    std::vector<std::vector<uint32_t>> tiles(size_t(ntx) * size_t(nty));
+    for (uint32_t i = 0; i < n; ++i)
+        for (int ty = tileY(tris[i].by0); ty <= tileY(tris[i].by1); ++ty)
+            for (int tx = tileX(tris[i].bx0); tx <= tileX(tris[i].bx1); ++tx) tiles[size_t(ty) * ntx + tx].push_back(i);
+    uint64_t boundsOverlap = 0;
+    for (int ty = 0; ty < nty; ++ty)
+        for (int tx = 0; tx < ntx; ++tx) {
+            std::vector<uint32_t> &list = tiles[size_t(ty) * ntx + tx];
+            std::sort(list.begin(), list.end(), [&](uint32_t a, uint32_t b) {
+                return tris[a].zmin < tris[b].zmin || (tris[a].zmin == tris[b].zmin && a < b);
+            });
+            for (size_t i = 0; i < list.size(); ++i) {
+                const PairTri &A = tris[list[i]];
+                for (size_t j = i + 1; j < list.size() && tris[list[j]].zmin <= A.zmax; ++j) {
+                    const PairTri &B = tris[list[j]];
+                    if (A.bx1 < B.bx0 || B.bx1 < A.bx0 || A.by1 < B.by0 || B.by1 < A.by0) continue;
+                    if (tileX(std::max(A.bx0, B.bx0)) != tx || tileY(std::max(A.by0, B.by0)) != ty) continue;
+                    ++boundsOverlap;
+                    const PairTri &Pt = A.rank < B.rank ? A : B;  // drawn first: the farther by the sort
+                    const PairTri &Qt = A.rank < B.rank ? B : A;
+                    const uint32_t P = Pt.src, Q = Qt.src;
+                    const int eyeQ = eyeSide(scene, v.cam, Q), eyeP = eyeSide(scene, v.cam, P);
+                    if (allOnSide(scene, Q, P, -eyeQ)) {
+                        ++r.behindPlane;
+                    } else if (allOnSide(scene, P, Q, eyeP)) {
+                        ++r.inFrontOfPlane;
+                    } else if (projectionsDisjoint(v.all, v.screenBegin[P], v.screenEnd[P], v.screenBegin[Q],
+                                                   v.screenEnd[Q])) {
+                        ++r.projectionsDisjoint;
+                    } else if (allOnSide(scene, P, Q, -eyeP)) {  // Newell's swap: Q is the farther one
+                        ++r.behindPlane;
+                        ++r.swapped;
+                    } else if (allOnSide(scene, Q, P, eyeQ)) {
+                        ++r.inFrontOfPlane;
+                        ++r.swapped;
+                    } else {
+                        ++r.unresolved;
+                    }
+                }
+            }
+        }
+    r.boundsDisjoint = r.pairs - boundsOverlap;
+    r.ms = msSince(t0);
+    return r;
+}
+
+PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility &ref, PainterKey key,
+                                bool overlapTests) {
+    PainterResult r;
+    r.key = key;
+    const auto t0 = Clock::now();
+    const std::vector<uint32_t> order = painterOrder(v, key);
+    r.sortMs = msSince(t0);
+    std::vector<DrawItem> items(order.size());
+    for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
+    r.trianglesDrawn = order.size();
+    const DrawStats st = drawInOrder(v, items, false, nullptr, nullptr, &r.id);
+    r.drawMs = st.ms;
+    r.fragments = st.fragments;
+    r.coveredPixels = st.coveredPixels;
+    r.overdraw = st.overdraw;
+    PixelComparison c = compareWithReference(v, ref, r.id);
+    r.wrongPixels = c.wrongPixels;
+    r.tiePixels = c.tiePixels;
+    r.edgePixels = c.edgePixels;
+    r.cls = std::move(c.cls);
+    r.memoryBytes = r.id.size() * sizeof(uint32_t) + order.size() * (sizeof(double) + sizeof(uint32_t));
+    if (overlapTests) r.overlaps = painterOverlapTests(v, key);
+    return r;
+}
+
+BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree) {
+    BspViewResult r;
+    const auto t0 = Clock::now();
+    const std::vector<uint32_t> order = bspBackToFront(tree, *v.scene, v.cam);
+    const BspViewPlanes planes = bspViewPlanes(tree, *v.scene, v.cam);
+    r.traverseMs = msSince(t0);
+    std::vector<DrawItem> items;
+    items.reserve(order.size());
+    for (uint32_t p : order)
+        if (v.screenEnd[tree.pieces[p].source] > v.screenBegin[tree.pieces[p].source])
+            items.push_back({tree.pieces[p].source, p});
+    r.piecesDrawn = items.size();
+    r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
+    PixelComparison c = compareWithReference(v, ref, r.id);
+    r.wrongPixels = c.wrongPixels;
+    r.tiePixels = c.tiePixels;
+    r.edgePixels = c.edgePixels;
+    r.cls = std::move(c.cls);
+    std::reverse(items.begin(), items.end());
+    r.frontToBack = drawInOrder(v, items, true, &tree, &planes, nullptr);
+    return r;
+}
+
+ABufferResult abufferForView(const OrderingView &v) {
+    const Scene &scene = *v.scene;
+    const size_t n = scene.triangleCount();
+    std::vector<float> alpha(n, 1.0f);
+    std::vector<uint8_t> rgb(3 * n, 255);
+    for (size_t t = 0; t < n; ++t) {
+        const uint32_t o = scene.triangleObject[t];
+        if (o == kExcludedTriangle) continue;
+        const SceneObject &ob = scene.objects[o];
+        alpha[t] = float(std::clamp(scene.materials[ob.material].alpha, 0.0, 1.0));
+        // A fixed color per source object: a multiplicative hash of its index, kept bright.
+        const uint32_t h = (ob.source + 1) * 2654435761u;
+        rgb[3 * t + 0] = uint8_t(64 + (h >> 24) % 192);
+        rgb[3 * t + 1] = uint8_t(64 + (h >> 16) % 192);
+        rgb[3 * t + 2] = uint8_t(64 + (h >> 8) % 192);
+    }
+    ABufferMaterials m;
+    m.alpha = alpha.data();
+    m.rgb = rgb.data();
+    m.singleSided = v.singleSided.data();
+    m.background[0] = m.background[1] = m.background[2] = 24;
+    return resolveABuffer(v.all, v.cam.width, v.cam.height, v.cam.orthographic, m);
+}
+
+OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const ReferenceVisibility &ref,
+                               const BspTree &tree, const EffectDecision &abuffer, const OrderingSettings &settings) {
+    const auto t0 = Clock::now();
+    OrderingResult r;
+    const OrderingView v = prepareOrderingView(scene, cam);
+    const size_t pixels = size_t(std::max(cam.width, 0)) * size_t(std::max(cam.height, 0));
+
+    r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);
+    r.bsp = bspForView(v, ref, tree);
+
+    // Overdraw by draw order, each with the depth test.
+    {
+        std::vector<DrawItem> submitted;
+        for (size_t t = 0; t < v.all.size(); ++t)
+            if (submitted.empty() || submitted.back().source != v.all.source[t]) submitted.push_back({v.all.source[t]});
+        r.overdrawByOrder.push_back({"submitted", drawInOrder(v, submitted, true, nullptr, nullptr, nullptr)});
+
+        std::vector<DrawItem> backToFront;
+        for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
+        r.overdrawByOrder.push_back({"back_to_front", drawInOrder(v, backToFront, true, nullptr, nullptr, nullptr)});
+
+        // Front to back by object: objects by the view depth of their bounding sphere's center
+        // (nearest first, ties by index), triangles of an object in submission order.
+        std::vector<uint32_t> objs(scene.objects.size());
+        std::iota(objs.begin(), objs.end(), 0u);
+        std::vector<double> od(objs.size());
+        for (uint32_t o : objs) od[o] = viewDepth(cam, scene.objects[o].sphere.center);
+        std::stable_sort(objs.begin(), objs.end(), [&](uint32_t a, uint32_t b) { return od[a] < od[b]; });
+        std::vector<DrawItem> frontToBack;
+        for (uint32_t o : objs)
+            for (uint32_t i = scene.objects[o].triBegin; i < scene.objects[o].triEnd; ++i) {
+                const uint32_t s = scene.objectTriangles[i];
+                if (v.screenEnd[s] > v.screenBegin[s]) frontToBack.push_back({s});
+            }
+        r.overdrawByOrder.push_back(
+            {"front_to_back_objects", drawInOrder(v, frontToBack, true, nullptr, nullptr, nullptr)});
+        r.overdrawByOrder.push_back({"bsp_front_to_back", r.bsp.frontToBack});
+    }
+
+    // Scanline.
+    r.scanline = scanlineVisibility(v.all, cam.width, cam.height, cam.orthographic, v.singleSided.data());
+    {
+        const PixelComparison c = compareWithReference(v, ref, r.scanline.id);
+        r.scanlineWrongPixels = c.wrongPixels;
+        r.scanlineTiePixels = c.tiePixels;
+        r.scanlineEdgePixels = c.edgePixels;
+    }
+
+    // The z-buffer as the pipeline's audit runs it (double depth, single-sided, submission order).
+    OrderingRow zrow;
+    zrow.method = "zbuffer";
+    {
+        ZBufferSettings zs;
+        zs.encoder = makeDepthEncoder(DepthFormat::f32, cam.nearZ, cam.farZ);
+        zs.orthographic = cam.orthographic;
+        zs.exactDepth = true;
+        zs.singleSided = v.singleSided.data();
+        const auto tz = Clock::now();
+        const ZBufferResult z = rasterize(v.all, cam.width, cam.height, zs);
+        zrow.drawMs = msSince(tz);
+        const PixelComparison c = compareWithReference(v, ref, z.buffer.id);
+        zrow.wrongPixels = c.wrongPixels;
+        zrow.tiePixels = c.tiePixels;
+        zrow.edgePixels = c.edgePixels;
+        zrow.overdraw = z.stats.overdraw;
+        zrow.memoryBytes = pixels * (sizeof(uint32_t) + sizeof(double));  // ids and depths
+    }
+
+    OrderingRow painter{"painter",           r.painter.sortMs,      r.painter.drawMs,
+                        r.painter.wrongPixels, r.painter.tiePixels, r.painter.edgePixels,
+                        r.painter.overdraw,    r.painter.memoryBytes};
+    OrderingRow bsp{"bsp",
+                    tree.stats.buildMs,
+                    r.bsp.traverseMs + r.bsp.backToFront.ms,
+                    r.bsp.wrongPixels,
+                    r.bsp.tiePixels,
+                    r.bsp.edgePixels,
+                    r.bsp.backToFront.overdraw,
+                    pixels * sizeof(uint32_t) + tree.stats.memoryBytes};
+    OrderingRow scan{"scanline",         r.scanline.buildMs,     r.scanline.ms,      r.scanlineWrongPixels,
+                     r.scanlineTiePixels, r.scanlineEdgePixels, r.scanline.overdraw, r.scanline.memoryBytes};
+    r.table = {painter, bsp, scan, zrow};
+
+    r.abufferReason = abuffer.reason;
+    if (abuffer.run) {
+        r.abuffer = abufferForView(v);
+        r.abufferRan = true;
+    }
+    r.ms = msSince(t0);
+    return r;
+}
+
+}  // namespace va

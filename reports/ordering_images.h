@@ -1,0 +1,45 @@
+// Images of the ordering analysis (analysis/ordering.h; docs/ordering.md), next to each view's other
+// images:
+//
+//   BASE.painter_errors.png  the reference visibility shaded by depth (gray, dimmed), every pixel the
+//                            painter's algorithm gets wrong in red, every depth tie in yellow and
+//                            every edge pixel (coverage uncertainty, ordering.h) in blue;
+//                            a legend strip below with the counts.
+//   BASE.overdraw_order.png  a bar chart: overdraw (depth-test passes / covered pixels, best 1) of the
+//                            view under each draw order, the value written at the end of each bar.
+//   BASE.abuffer.png         the A-buffer's antialiased composite (only where the A-buffer ran).
+// Files go through writePngRgb8 (a temporary name, then renamed).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "analysis/ordering.h"
+#include "reports/report.h"
+
+namespace va {
+
+struct OrderingImageNames {
+    std::string painterErrorsPng;  // BASE.painter_errors.png
+    std::string overdrawOrderPng;  // BASE.overdraw_order.png
+    std::string abufferPng;        // BASE.abuffer.png
+};
+OrderingImageNames orderingImageNames(const std::string &baseName);
+
+constexpr Rgb8 kOrderWrongColor{255, 32, 32};
+constexpr Rgb8 kOrderTieColor{255, 220, 0};
+constexpr Rgb8 kOrderEdgeColor{64, 128, 255};
+
+// The painter-errors picture as RGB8 (width x (height + legend)); *canvasH receives its height.
+std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH);
+bool writePainterErrorsImage(const ReferenceVisibility &ref, const PainterResult &painter, const std::string &path,
+                             std::string *err);
+
+// The bar chart as RGB8, kOverdrawChartWidth wide; *canvasH receives its height.
+constexpr int kOverdrawChartWidth = 480;
+std::vector<uint8_t> renderOverdrawByOrder(const std::vector<OrderOverdraw> &orders, int *canvasH);
+bool writeOverdrawByOrderChart(const std::vector<OrderOverdraw> &orders, const std::string &path, std::string *err);
+
+bool writeABufferImage(const ABufferResult &abuffer, const std::string &path, std::string *err);
+
+}  // namespace va

@@ -1,0 +1,306 @@
+// The BSP tree (analysis/bsp_tree.h): exact plane classification, splits, the hard cases of the
+// ordering issue (cyclic overlap, interpenetration, a vertex on a splitting plane, coplanar
+// triangles, a scene far from the origin, a closed mesh from inside and outside), and traversal
+// against the reference visibility. Suite BspTree*.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "analysis/audit.h"
+#include "analysis/bsp_tree.h"
+#include "analysis/demo.h"
+#include "analysis/load.h"
+#include "analysis/ordering.h"
+
+namespace va {
+namespace {
+
+// A scene of loose triangles (one object each), one material.
+Scene triangleScene(const std::vector<std::array<Vec3, 3>> &tris, bool doubleSided = false) {
+    SceneBuildInput in;
+    Material m;
+    m.doubleSided = doubleSided;
+    in.materials = {m};
+    for (size_t i = 0; i < tris.size(); ++i) {
+        SceneBuildInput::Object o;
+        o.name = "t" + std::to_string(i);
+        o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
+        o.geometry.indices = {0, 1, 2};
+        in.objects.push_back(std::move(o));
+    }
+    return buildScene(std::move(in));
+}
+
+// Three thin triangles ("sticks") around the z axis, each rotated 120 degrees from the last, each
+// rising along its length (z = 0.3 x in its own frame). The sticks' lines are the sides of an
+// equilateral triangle of inradius 1, so stick k's high end crosses over stick k+1's low end:
+// 0 over 1, 1 over 2, 2 over 0 -- a cycle. Front faces point to +z (counter-clockwise from above).
+// `scale` and `offset` move the whole scene (scale a power of two keeps the coordinates exact).
+std::vector<std::array<Vec3, 3>> cyclicSticks(double scale = 1, Vec3 offset = {}) {
+    std::vector<std::array<Vec3, 3>> out;
+    const Vec3 base[3] = {{-4, -1.625, -1.25}, {4, -1, 1.25}, {-4, -0.375, -1.25}};
+    for (int k = 0; k < 3; ++k) {
+        const double a = 2 * kPi * k / 3, c = std::cos(a), s = std::sin(a);
+        std::array<Vec3, 3> t;
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = base[i];
+            // Round the rotated coordinates to multiples of 2^-10 so that scaling and offsetting
+            // stay exact in double.
+            auto q = [](double v) { return std::round(v * 1024) / 1024; };
+            const Vec3 r{q(c * p.x - s * p.y), q(s * p.x + c * p.y), p.z};
+            t[i] = offset + r * scale;
+        }
+        out.push_back(t);
+    }
+    return out;
+}
+
+Camera topCamera(int size = 200, double height = 10, Vec3 center = {}) {
+    CameraSpec cs;
+    cs.eye = center + Vec3{0, 0, 10};
+    cs.target = center;
+    cs.up = {0, 1, 0};
+    cs.orthographic = true;
+    cs.orthoHeight = height;
+    cs.nearZ = 0.5;
+    cs.farZ = 100;
+    cs.width = cs.height = size;
+    Camera cam;
+    std::string err;
+    EXPECT_TRUE(makeCamera(cs, &cam, &err)) << err;
+    return cam;
+}
+
+// The tree's structure as plain numbers, to compare two trees.
+std::vector<int64_t> signature(const BspTree &t) {
+    std::vector<int64_t> s;
+    for (const BspTreeNode &n : t.nodes) {
+        s.insert(s.end(), {n.planeSource, n.front, n.back, n.pieceCount});
+        for (uint32_t i = 0; i < n.pieceCount; ++i) {
+            const BspPiece &p = t.pieces[t.nodePieces[n.firstPiece + i]];
+            s.insert(s.end(), {p.source, p.vertexCount, p.constraintCount});
+        }
+    }
+    return s;
+}
+
+TEST(BspTree, Orient3dSignAndExactness) {
+    EXPECT_EQ(orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}), 1);   // front of a CCW triangle
+    EXPECT_EQ(orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, -1}), -1);
+    EXPECT_EQ(orient3d({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {5, 7, 0}), 0);
+    // A point on the plane far from the origin, where the double evaluation of n.p + k is not 0:
+    // the plane through (1e5 + 0.1, ...) -- a decimal that double cannot hold -- and points on it.
+    const Vec3 a{1e5 + 0.1, 1e5 + 0.2, 1e5 + 0.3}, b = a + Vec3{1, 0, 0}, c = a + Vec3{0, 1, 0};
+    const Vec3 onPlane{1e5 + 1.7, 1e5 - 3.3, a.z};
+    EXPECT_EQ(orient3d(a, b, c, onPlane), 0);
+    EXPECT_EQ(orient3d(a, b, c, {onPlane.x, onPlane.y, std::nextafter(a.z, 2e5)}), 1);
+    EXPECT_EQ(orient3d(a, b, c, {onPlane.x, onPlane.y, std::nextafter(a.z, 0.0)}), -1);
+}
+
+TEST(BspTree, EmptyAndSingle) {
+    const Scene empty = triangleScene({});
+    const BspTree t0 = buildBspTree(empty);
+    EXPECT_EQ(t0.nodes.size(), 0u);
+    EXPECT_TRUE(bspBackToFront(t0, empty, topCamera()).empty());
+    const Scene one = triangleScene({{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}});
+    const BspTree t1 = buildBspTree(one);
+    EXPECT_EQ(t1.stats.nodes, 1u);
+    EXPECT_EQ(t1.stats.depth, 1u);
+    EXPECT_EQ(t1.stats.pieces, 1u);
+    EXPECT_EQ(t1.stats.splits, 0u);
+}
+
+// A vertex exactly on the splitter's plane: the triangle touching it goes whole to one side (no
+// split, no sliver); a triangle straddling it through that vertex splits into two triangles, not
+// a triangle and a quad.
+TEST(BspTree, VertexOnSplittingPlane) {
+    const std::array<Vec3, 3> floor{Vec3{-10, -10, 0}, Vec3{10, -10, 0}, Vec3{0, 10, 0}};
+    {
+        const Scene s = triangleScene({floor, {Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{0, 1, 1}}});
+        const BspTree t = buildBspTree(s);
+        EXPECT_EQ(t.nodes[0].planeSource, 0u);
+        EXPECT_EQ(t.stats.splits, 0u);
+        EXPECT_EQ(t.stats.pieces, 2u);
+        EXPECT_EQ(t.stats.nodes, 2u);
+        EXPECT_EQ(t.nodes[0].front, 1);
+        EXPECT_EQ(t.nodes[0].back, -1);
+    }
+    {
+        const Scene s = triangleScene({floor, {Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{1, 1, -1}}});
+        const BspTree t = buildBspTree(s);
+        EXPECT_EQ(t.nodes[0].planeSource, 0u);
+        EXPECT_EQ(t.stats.splits, 1u);
+        EXPECT_EQ(t.stats.pieces, 3u);
+        EXPECT_EQ(t.stats.trianglesOut, 3u);  // both halves are triangles: the vertex on the plane is shared
+        EXPECT_EQ(t.stats.degeneratePieces, 0u);
+        EXPECT_EQ(t.stats.splitSources, 1u);
+        // The new vertex lies on the plane z = 0 (computed in double: exactly here, the edge's z runs
+        // from 1 to -1 and the crossing is at t = 1/2).
+        for (uint32_t p : t.nodePieces) {
+            const BspPiece &pc = t.pieces[p];
+            if (pc.source != 1) continue;
+            EXPECT_EQ(pc.vertexCount, 3u);
+            EXPECT_EQ(pc.constraintCount, 1u);
+            bool hasNew = false;
+            for (uint32_t i = 0; i < pc.vertexCount; ++i) {
+                const Vec3 v = t.vertices[pc.firstVertex + i];
+                if (v == Vec3{1, 0.5, 0}) hasNew = true;
+            }
+            EXPECT_TRUE(hasNew);
+        }
+    }
+}
+
+// Coplanar overlapping triangles stay on one node; drawn back to front they tie exactly (same
+// plane): 0 wrong pixels, every pixel both cover is a tie where the higher id was drawn last.
+TEST(BspTree, CoplanarOverlapping) {
+    const Scene s = triangleScene({{Vec3{-3, -3, 0}, Vec3{3, -3, 0}, Vec3{0, 3, 0}},
+                                   {Vec3{-3, 3, 0}, Vec3{0, -3, 0}, Vec3{3, 3, 0}}});
+    const BspTree t = buildBspTree(s);
+    EXPECT_EQ(t.stats.nodes, 1u);
+    EXPECT_EQ(t.stats.splits, 0u);
+    EXPECT_EQ(t.nodes[0].pieceCount, 2u);
+    const Camera cam = topCamera(100);
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    const OrderingView v = prepareOrderingView(s, cam);
+    const BspViewResult r = bspForView(v, ref, t);
+    EXPECT_EQ(r.wrongPixels, 0u);
+    // Overlap pixels: covered by both (counted with the fragment core through the reference's own
+    // counts: fragments - covered pixels = pixels covered twice, as each pixel has at most 2).
+    EXPECT_EQ(r.tiePixels, ref.fragments - ref.coveredPixels);
+    EXPECT_GT(r.tiePixels, 0u);
+}
+
+// The cycle: no order of the three triangles is right; the BSP splits and gets every pixel right.
+TEST(BspTree, CyclicOverlapSplitsAndIsExact) {
+    const Scene s = triangleScene(cyclicSticks());
+    const BspTree t = buildBspTree(s);
+    EXPECT_GE(t.stats.splits, 1u);
+    EXPECT_EQ(t.stats.pieces, 3 + t.stats.splits);
+    EXPECT_EQ(t.stats.degeneratePieces, 0u);
+    const Camera cam = topCamera();
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    ASSERT_GT(ref.coveredPixels, 0u);
+    const OrderingView v = prepareOrderingView(s, cam);
+    const BspViewResult r = bspForView(v, ref, t);
+    EXPECT_EQ(r.wrongPixels, 0u);
+    EXPECT_EQ(r.tiePixels, 0u);
+    // Pieces partition their sources: back to front writes exactly the reference's fragments.
+    EXPECT_EQ(r.backToFront.fragments, ref.fragments);
+    // Front to back with the depth test: every fragment passes exactly once per pixel (nothing is
+    // drawn behind what is already there), the least possible overdraw.
+    EXPECT_EQ(r.frontToBack.depthPasses, ref.coveredPixels);
+    EXPECT_DOUBLE_EQ(r.frontToBack.overdraw, 1.0);
+}
+
+// Two triangles passing through each other: the BSP cuts one along the other's plane.
+TEST(BspTree, Interpenetrating) {
+    const Scene s = triangleScene({{Vec3{-4, -3, -1}, Vec3{4, -3, -1}, Vec3{0, 3, 1}},
+                                   {Vec3{-4, 3, -1}, Vec3{0, -3, 1}, Vec3{4, 3, -1}}});
+    const BspTree t = buildBspTree(s);
+    EXPECT_EQ(t.stats.splits, 1u);
+    EXPECT_EQ(t.stats.pieces, 3u);
+    const Camera cam = topCamera();
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    const OrderingView v = prepareOrderingView(s, cam);
+    const BspViewResult r = bspForView(v, ref, t);
+    EXPECT_EQ(r.wrongPixels, 0u);
+}
+
+// Classification does not depend on where the scene is: the cyclic sticks and the vertex-on-plane
+// case scaled to 1e-3 (2^-10) features and moved 1e5 from the origin (exactly: every coordinate
+// is a multiple of 2^-20 below 2^17) build the same tree as at the origin.
+TEST(BspTree, FarFromOriginSameClassification) {
+    auto scene = [](double scale, Vec3 off) {
+        std::vector<std::array<Vec3, 3>> tris = cyclicSticks(scale, off);
+        tris.push_back({off + Vec3{-10, -10, 0} * scale, off + Vec3{10, -10, 0} * scale, off + Vec3{0, 10, 0} * scale});
+        tris.push_back({off + Vec3{0, 0, 0} * scale, off + Vec3{1, 0, 1} * scale, off + Vec3{0, 1, 1} * scale});
+        tris.push_back({off + Vec3{0, 0, 0} * scale, off + Vec3{1, 0, 1} * scale, off + Vec3{1, 1, -1} * scale});
+        return triangleScene(tris);
+    };
+    const BspTree near = buildBspTree(scene(1, {}));
+    const double s = std::ldexp(1.0, -10);
+    const BspTree far = buildBspTree(scene(s, {1e5, 1e5, 1e5}));
+    EXPECT_EQ(signature(near), signature(far));
+    EXPECT_EQ(near.stats.splits, far.stats.splits);
+    EXPECT_EQ(near.stats.degeneratePieces, 0u);
+    EXPECT_EQ(far.stats.degeneratePieces, 0u);
+    // And drawn from above, the far scene is exact too.
+    const Scene fs = scene(s, {1e5, 1e5, 1e5});
+    const Camera cam = topCamera(200, 10 * s, {1e5, 1e5, 1e5});
+    const ReferenceVisibility ref = referenceVisibility(fs, cam);
+    ASSERT_GT(ref.coveredPixels, 0u);
+    const BspViewResult r = bspForView(prepareOrderingView(fs, cam), ref, far);
+    EXPECT_EQ(r.wrongPixels, 0u);
+}
+
+// A closed mesh: a convex one splits nothing; from outside (single-sided) and from inside
+// (double-sided, so the inner faces show) back to front is exact.
+TEST(BspTree, ClosedMeshInsideAndOutside) {
+    for (bool doubleSided : {false, true}) {
+        SceneBuildInput in;
+        Material m;
+        m.doubleSided = doubleSided;
+        in.materials = {m};
+        SceneBuildInput::Object o;
+        o.name = "sphere";
+        o.geometry = uvSphereMesh({0, 0, 0}, 2, 24, 12);
+        in.objects.push_back(std::move(o));
+        SceneBuildInput::Object b;
+        b.name = "box";
+        b.geometry = boxMesh({0, 0, 0}, {0.5, 0.5, 0.5});
+        in.objects.push_back(std::move(b));
+        const Scene s = buildScene(std::move(in));
+        const BspTree t = buildBspTree(s);
+        EXPECT_EQ(t.stats.trianglesIn, s.objectTriangles.size());
+        CameraSpec cs;
+        cs.eye = doubleSided ? Vec3{1.1, 0.3, 0.2} : Vec3{0.5, 1, 7};  // between the box and the sphere / outside
+        cs.target = doubleSided ? Vec3{-1, -0.2, 0.1} : Vec3{0, 0, 0};
+        cs.width = 160;
+        cs.height = 120;
+        cs.nearZ = 0.05;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+        const ReferenceVisibility ref = referenceVisibility(s, cam);
+        ASSERT_GT(ref.coveredPixels, 0u);
+        const BspViewResult r = bspForView(prepareOrderingView(s, cam), ref, t);
+        EXPECT_EQ(r.wrongPixels, 0u) << (doubleSided ? "inside" : "outside");
+        EXPECT_EQ(r.tiePixels, 0u);
+    }
+}
+
+// The heuristic's knobs do what they say: "fewest splits" never splits more than "balance", and the
+// default sits between; all build valid trees with the same drawn result.
+TEST(BspTree, HeuristicsOnDemo) {
+    const Scene s = demoScene();
+    const BspTree fewest = buildBspTree(s, {16, 1, 0});
+    const BspTree balanced = buildBspTree(s, {16, 0, 1});
+    const BspTree dflt = buildBspTree(s);
+    EXPECT_LE(fewest.stats.splits, balanced.stats.splits);
+    EXPECT_LE(fewest.stats.splits, dflt.stats.splits);
+    std::printf("demo BSP (%llu triangles): fewest splits %llu (depth %u), balanced %llu (depth %u), default %llu "
+                "(depth %u, %.1f ms)\n",
+                (unsigned long long)dflt.stats.trianglesIn, (unsigned long long)fewest.stats.splits,
+                fewest.stats.depth, (unsigned long long)balanced.stats.splits, balanced.stats.depth,
+                (unsigned long long)dflt.stats.splits, dflt.stats.depth, dflt.stats.buildMs);
+    for (const ViewSpec &vs : s.views) {
+        Camera cam;
+        std::string err;
+        CameraSpec spec = vs.camera;
+        spec.width = 320;
+        spec.height = 180;
+        ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+        const ReferenceVisibility ref = referenceVisibility(s, cam);
+        const OrderingView v = prepareOrderingView(s, cam);
+        for (const BspTree *t : {&fewest, &balanced, &dflt}) {
+            const BspViewResult r = bspForView(v, ref, *t);
+            EXPECT_EQ(r.wrongPixels, 0u) << vs.name;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace va

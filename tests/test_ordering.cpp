@@ -1,0 +1,362 @@
+// Draw order (analysis/ordering.h): the painter's algorithm against the reference, Newell's pair
+// tests, overdraw under each draw order, the ordering table on the demo and the dungeon, and the
+// ordering images. Suite Ordering*.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "analysis/demo.h"
+#include "analysis/effects_plan.h"
+#include "analysis/load.h"
+#include "analysis/ordering.h"
+#include "render/raster_core.h"
+#include "reports/ordering_images.h"
+
+namespace va {
+namespace {
+
+Scene looseTriangles(const std::vector<std::array<Vec3, 3>> &tris) {
+    SceneBuildInput in;
+    in.materials = {Material{}};
+    for (size_t i = 0; i < tris.size(); ++i) {
+        SceneBuildInput::Object o;
+        o.name = "t" + std::to_string(i);
+        o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
+        o.geometry.indices = {0, 1, 2};
+        in.objects.push_back(std::move(o));
+    }
+    return buildScene(std::move(in));
+}
+
+// The cyclic sticks of test_bsp_tree.cpp (three thin triangles, each over the next), counter-
+// clockwise from above.
+std::vector<std::array<Vec3, 3>> sticks() {
+    std::vector<std::array<Vec3, 3>> out;
+    const Vec3 base[3] = {{-4, -1.625, -1.25}, {4, -1, 1.25}, {-4, -0.375, -1.25}};
+    for (int k = 0; k < 3; ++k) {
+        const double a = 2 * kPi * k / 3, c = std::cos(a), s = std::sin(a);
+        std::array<Vec3, 3> t;
+        for (int i = 0; i < 3; ++i)
+            t[i] = {std::round((c * base[i].x - s * base[i].y) * 1024) / 1024,
+                    std::round((s * base[i].x + c * base[i].y) * 1024) / 1024, base[i].z};
+        out.push_back(t);
+    }
+    return out;
+}
+
+Camera orthoTop(int size = 200) {
+    CameraSpec cs;
+    cs.eye = {0, 0, 10};
+    cs.target = {0, 0, 0};
+    cs.orthographic = true;
+    cs.orthoHeight = 10;
+    cs.nearZ = 0.5;
+    cs.farZ = 100;
+    cs.width = cs.height = size;
+    Camera cam;
+    std::string err;
+    EXPECT_TRUE(makeCamera(cs, &cam, &err)) << err;
+    return cam;
+}
+
+// Every fragment of every drawn triangle, per pixel (source, depth), through the shared coverage
+// core: the expectations below are computed from these independently of ordering.cpp.
+struct AllFragments {
+    const OrderingView &v;
+    std::vector<std::vector<std::pair<uint32_t, double>>> perPixel;
+    uint32_t cur = 0;
+    bool beginTriangle(size_t t, bool front) {
+        cur = v.all.source[t];
+        return !v.singleSided[cur] || front;
+    }
+    void fragment(size_t i, size_t, double d) { perPixel[i].push_back({cur, d}); }
+    void endTriangle(size_t, uint64_t) {}
+};
+
+// The painter on the cycle: all three centroids are at the same depth (the sticks are rotations
+// of one another about the view axis), so the order is by descending id: 2, 1, 0; the last drawn
+// covering a pixel shows. 0 over 1 and 1 over 2 are right; 2 under 0 is wrong wherever 2 is in
+// front of 0.
+TEST(Ordering, PainterOnCyclicOverlap) {
+    const Scene s = looseTriangles(sticks());
+    const Camera cam = orthoTop();
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    const OrderingView v = prepareOrderingView(s, cam);
+    EXPECT_EQ(painterOrder(v, PainterKey::centroid), (std::vector<uint32_t>{2, 1, 0}));
+
+    AllFragments all{v, std::vector<std::vector<std::pair<uint32_t, double>>>(200 * 200)};
+    forEachFragment(v.all, 200, 200, true, all);
+    uint64_t expectWrong = 0;
+    for (const auto &frags : all.perPixel) {
+        if (frags.size() < 2) continue;
+        uint32_t last = UINT32_MAX, nearest = 0;
+        double dn = INFINITY;
+        for (const auto &[src, d] : frags) {
+            last = std::min(last, src);  // drawn 2, 1, 0: the lowest id is drawn last
+            if (d < dn) dn = d, nearest = src;
+        }
+        expectWrong += last != nearest;
+    }
+    const PainterResult p = paintersAlgorithm(v, ref, PainterKey::centroid);
+    EXPECT_EQ(p.wrongPixels + p.edgePixels, expectWrong);
+    EXPECT_EQ(p.wrongPixels, 143u);  // the literal, as measured: the 0-2 crossing
+    EXPECT_EQ(p.edgePixels, 0u);     // no wrong pixel within snapping distance of an edge
+    EXPECT_EQ(p.tiePixels, 0u);
+    EXPECT_EQ(p.fragments, ref.fragments);
+    // No classic test resolves any of the three pairs: each pair's projections overlap and each
+    // triangle has vertices on both sides of the other's plane.
+    EXPECT_EQ(p.overlaps.trianglesTested, 3u);
+    EXPECT_EQ(p.overlaps.pairs, 3u);
+    EXPECT_EQ(p.overlaps.unresolved, 3u);
+    EXPECT_EQ(p.overlaps.boundsDisjoint + p.overlaps.behindPlane + p.overlaps.inFrontOfPlane +
+                  p.overlaps.projectionsDisjoint, 0u);
+}
+
+// Interpenetration: two triangles crossing along a line; whichever is drawn last is wrong on the
+// other's side of the line. No test resolves the pair.
+TEST(Ordering, PainterOnInterpenetration) {
+    const Scene s = looseTriangles({{Vec3{-4, -3, -1}, Vec3{4, -3, -1}, Vec3{0, 3, 1}},
+                                    {Vec3{-4, 3, -1}, Vec3{0, -3, 1}, Vec3{4, 3, -1}}});
+    const Camera cam = orthoTop();
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    const OrderingView v = prepareOrderingView(s, cam);
+    const PainterResult p = paintersAlgorithm(v, ref, PainterKey::centroid);
+    EXPECT_EQ(p.overlaps.pairs, 1u);
+    EXPECT_EQ(p.overlaps.unresolved, 1u);
+    // Centroid depths: t0 (z = y/3) has centroid z = -1/3, t1 (z = -y/3) +1/3: t1 is nearer and is
+    // drawn last; it is wrong where t0 is in front of it (y > 0) and both cover.
+    uint64_t expect = 0;
+    AllFragments all{v, std::vector<std::vector<std::pair<uint32_t, double>>>(200 * 200)};
+    forEachFragment(v.all, 200, 200, true, all);
+    for (const auto &f : all.perPixel)
+        if (f.size() == 2) {
+            const uint32_t nearest = f[0].second < f[1].second ? f[0].first : f[1].first;
+            expect += nearest != 1 && f[0].second != f[1].second;
+        }
+    EXPECT_EQ(p.wrongPixels + p.edgePixels, expect);
+    EXPECT_GT(p.wrongPixels, 0u);
+}
+
+// The pair counts against a brute force over all pairs, on random triangles in a perspective view
+// (depth ranges and rectangles from the same screen vertices).
+TEST(Ordering, OverlapPairsMatchBruteForce) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> U(-5, 5);
+    std::vector<std::array<Vec3, 3>> tris;
+    for (int i = 0; i < 300; ++i) {
+        const Vec3 c{U(rng), U(rng), U(rng) - 10};
+        std::array<Vec3, 3> t;
+        for (auto &p : t) p = c + Vec3{U(rng), U(rng), U(rng)} * 0.3;
+        tris.push_back(t);
+    }
+    SceneBuildInput in;
+    Material m;
+    m.doubleSided = true;
+    in.materials = {m};
+    for (size_t i = 0; i < tris.size(); ++i) {
+        SceneBuildInput::Object o;
+        o.name = "t";
+        o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
+        o.geometry.indices = {0, 1, 2};
+        in.objects.push_back(std::move(o));
+    }
+    const Scene s = buildScene(std::move(in));
+    CameraSpec cs;
+    cs.eye = {0, 0, 2};
+    cs.target = {0, 0, -10};
+    cs.width = 160;
+    cs.height = 120;
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+    const OrderingView v = prepareOrderingView(s, cam);
+    const OverlapTests o = painterOverlapTests(v, PainterKey::centroid);
+
+    struct R {
+        double z0 = INFINITY, z1 = -INFINITY, x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    };
+    std::vector<R> rs;
+    for (uint32_t t = 0; t < s.triangleCount(); ++t) {
+        if (v.screenEnd[t] == v.screenBegin[t]) continue;
+        bool area = false;
+        for (uint32_t k = v.screenBegin[t]; k < v.screenEnd[t]; ++k) {
+            const int32_t *p = &v.all.xy[6 * k];
+            area = area || (int64_t(p[2]) - p[0]) * (int64_t(p[5]) - p[1]) - (int64_t(p[3]) - p[1]) * (int64_t(p[4]) - p[0]);
+        }
+        if (!area) continue;
+        R r;
+        const DepthPlane &pl = v.all.planes[v.all.plane[v.screenBegin[t]]];
+        for (uint32_t k = v.screenBegin[t]; k < v.screenEnd[t]; ++k)
+            for (int i = 0; i < 3; ++i) {
+                const double x = v.all.xy[6 * k + 2 * i] / 256.0, y = v.all.xy[6 * k + 2 * i + 1] / 256.0;
+                const double d = viewDepthAt(cam, pl, x, y);
+                r.z0 = std::min(r.z0, d), r.z1 = std::max(r.z1, d);
+                r.x0 = std::min(r.x0, x), r.x1 = std::max(r.x1, x);
+                r.y0 = std::min(r.y0, y), r.y1 = std::max(r.y1, y);
+            }
+        rs.push_back(r);
+    }
+    uint64_t pairs = 0, rectDisjoint = 0;
+    for (size_t i = 0; i < rs.size(); ++i)
+        for (size_t j = i + 1; j < rs.size(); ++j) {
+            if (!(rs[i].z0 <= rs[j].z1 && rs[j].z0 <= rs[i].z1)) continue;
+            ++pairs;
+            rectDisjoint += rs[i].x1 < rs[j].x0 || rs[j].x1 < rs[i].x0 || rs[i].y1 < rs[j].y0 || rs[j].y1 < rs[i].y0;
+        }
+    EXPECT_EQ(o.trianglesTested, rs.size());
+    EXPECT_EQ(o.pairs, pairs);
+    EXPECT_EQ(o.boundsDisjoint, rectDisjoint);
+    EXPECT_EQ(o.boundsDisjoint + o.behindPlane + o.inFrontOfPlane + o.projectionsDisjoint + o.unresolved, o.pairs);
+    EXPECT_GT(o.unresolved, 0u);  // random overlapping triangles interpenetrate
+}
+
+// The three sort keys differ on a case made for it: a long triangle whose far end is farther than
+// a small one's, but whose near vertex is nearer.
+TEST(Ordering, PainterKeys) {
+    const Scene s = looseTriangles({{Vec3{-1, -1, -5}, Vec3{1, -1, -5}, Vec3{0, 1, -5}},       // small, z = -5
+                                    {Vec3{-3, -3, -9}, Vec3{3, -3, -9}, Vec3{0, 3, -4}}});   // long: -9 .. -4
+    CameraSpec cs;
+    cs.eye = {0, 0, 0};
+    cs.target = {0, 0, -1};
+    cs.width = cs.height = 64;
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+    const OrderingView v = prepareOrderingView(s, cam);
+    // Centroid: small 5, long (9 + 9 + 4) / 3 = 7.33 -> long first. Farthest: 5 vs 9 -> long first.
+    // Nearest: 5 vs 4 -> small first (the long one is "nearer").
+    EXPECT_EQ(painterOrder(v, PainterKey::centroid), (std::vector<uint32_t>{1, 0}));
+    EXPECT_EQ(painterOrder(v, PainterKey::farthestVertex), (std::vector<uint32_t>{1, 0}));
+    EXPECT_EQ(painterOrder(v, PainterKey::nearestVertex), (std::vector<uint32_t>{0, 1}));
+}
+
+void printTable(const std::string &what, const OrderingResult &r) {
+    std::printf("%s ordering (painter key %s):\n", what.c_str(), painterKeyName(r.painter.key));
+    std::printf("  %-9s %10s %10s %8s %6s %6s %9s %12s\n", "method", "build_ms", "draw_ms", "wrong", "ties", "edge",
+                "overdraw", "memory_B");
+    for (const OrderingRow &row : r.table)
+        std::printf("  %-9s %10.2f %10.2f %8llu %6llu %6llu %9.3f %12llu\n", row.method.c_str(), row.buildMs, row.drawMs,
+                    (unsigned long long)row.wrongPixels, (unsigned long long)row.tiePixels,
+                    (unsigned long long)row.edgePixels, row.overdraw, (unsigned long long)row.memoryBytes);
+    for (const OrderOverdraw &o : r.overdrawByOrder)
+        std::printf("  overdraw %-22s %.3f (%llu passes, %llu fragments)\n", o.order.c_str(), o.stats.overdraw,
+                    (unsigned long long)o.stats.depthPasses, (unsigned long long)o.stats.fragments);
+    const OverlapTests &t = r.painter.overlaps;
+    std::printf("  painter pairs %llu: bounds %llu, behind %llu, in front %llu, projections %llu, unresolved %llu "
+                "(swapped %llu)\n",
+                (unsigned long long)t.pairs, (unsigned long long)t.boundsDisjoint, (unsigned long long)t.behindPlane,
+                (unsigned long long)t.inFrontOfPlane, (unsigned long long)t.projectionsDisjoint,
+                (unsigned long long)t.unresolved, (unsigned long long)t.swapped);
+    if (r.abufferRan)
+        std::printf("  abuffer: %llu fragments, avg list %.2f, max %u, %llu bytes, %llu edge px\n",
+                    (unsigned long long)r.abuffer.fragments, r.abuffer.averageListLength, r.abuffer.maxListLength,
+                    (unsigned long long)r.abuffer.memoryBytes, (unsigned long long)r.abuffer.edgePixels);
+    else
+        std::printf("  abuffer skipped: %s\n", r.abufferReason.c_str());
+}
+
+// The whole analysis on a scene's views: what must hold for every correct method.
+void checkScene(const Scene &s, const std::vector<ViewSpec> &views, const std::string &what) {
+    const BspTree tree = buildBspTree(s);
+    std::printf("%s: BSP over %llu triangles: %llu nodes, depth %u, %llu splits, %llu triangles after, %.1f ms\n",
+                what.c_str(), (unsigned long long)tree.stats.trianglesIn, (unsigned long long)tree.stats.nodes,
+                tree.stats.depth, (unsigned long long)tree.stats.splits, (unsigned long long)tree.stats.trianglesOut,
+                tree.stats.buildMs);
+    const EffectPlan plan = planEffects(s, {});
+    for (const ViewSpec &vs : views) {
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(vs.camera, &cam, &err)) << err;
+        const ReferenceVisibility ref = referenceVisibility(s, cam);
+        const OrderingResult r = analyzeOrdering(s, cam, ref, tree, plan.abuffer);
+        printTable(what + "/" + vs.name, r);
+        ASSERT_EQ(r.table.size(), 4u);
+        EXPECT_EQ(r.table[1].method, "bsp");
+        EXPECT_EQ(r.table[1].wrongPixels, 0u) << what << "/" << vs.name << ": BSP";
+        EXPECT_EQ(r.table[2].wrongPixels, 0u) << what << "/" << vs.name << ": scanline";
+        EXPECT_EQ(r.table[2].tiePixels + r.table[2].edgePixels, 0u) << "scanline: the reference's coverage and ties";
+        EXPECT_EQ(r.table[3].tiePixels + r.table[3].edgePixels, 0u) << "z-buffer in ascending id: the reference";
+        EXPECT_EQ(r.table[3].wrongPixels, 0u) << what << "/" << vs.name << ": z-buffer";
+        EXPECT_LT(r.scanline.memoryBytes, r.scanline.zbufferBytes);
+        // Every order draws the same fragments; front to back over the BSP has the least overdraw.
+        ASSERT_EQ(r.overdrawByOrder.size(), 4u);
+        for (const OrderOverdraw &o : r.overdrawByOrder) {
+            EXPECT_EQ(o.stats.fragments, ref.fragments) << o.order;
+            EXPECT_EQ(o.stats.coveredPixels, ref.coveredPixels) << o.order;
+            EXPECT_LE(r.bsp.frontToBack.depthPasses, o.stats.depthPasses) << o.order;
+        }
+        // Back to front is the worst order for a depth test: every fragment nearer than all before.
+        EXPECT_GE(r.overdrawByOrder[1].stats.depthPasses, r.overdrawByOrder[2].stats.depthPasses);
+        EXPECT_EQ(r.abufferRan, plan.abuffer.run);
+    }
+}
+
+TEST(OrderingScenes, Demo) {
+    const Scene s = demoScene();
+    std::vector<ViewSpec> views = s.views;
+    for (ViewSpec &v : views) v.camera.width = 480, v.camera.height = 270;
+    checkScene(s, views, "demo");
+}
+
+TEST(OrderingScenes, Hall) {
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadScene(std::string(VISAUDIT_EXAMPLES) + "/hall.scene.json", {}, &s, &err)) << err;
+    std::vector<ViewSpec> views = s.views;
+    for (ViewSpec &v : views) v.camera.width = 320, v.camera.height = 180;
+    checkScene(s, views, "hall");
+}
+
+TEST(OrderingScenes, CastleDungeon) {
+    const std::string path = std::string(VISAUDIT_TEST_DATA) + "/castle/level/level-dungeon.gltf";
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "not fetched: " << path << " (scripts/fetch-data.sh)";
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadScene(path, {}, &s, &err)) << err;
+    std::vector<ViewSpec> views = s.views;
+    for (const ViewSpec &v : orbitViews(s, 3)) views.push_back(v);
+    for (ViewSpec &v : views) v.camera.width = 480, v.camera.height = 270;
+    checkScene(s, views, "dungeon");
+}
+
+TEST(Ordering, Images) {
+    const Scene s = looseTriangles(sticks());
+    const Camera cam = orthoTop(120);
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    const OrderingView v = prepareOrderingView(s, cam);
+    const PainterResult p = paintersAlgorithm(v, ref, PainterKey::centroid);
+    ASSERT_GT(p.wrongPixels, 0u);
+    int h = 0;
+    const std::vector<uint8_t> img = renderPainterErrors(ref, p, &h);
+    ASSERT_GT(h, 120);
+    uint64_t red = 0;
+    for (size_t i = 0; i < size_t(120) * 120; ++i)
+        red += img[3 * i] == kOrderWrongColor.r && img[3 * i + 1] == kOrderWrongColor.g && img[3 * i + 2] == kOrderWrongColor.b;
+    EXPECT_EQ(red, p.wrongPixels);
+
+    std::vector<OrderOverdraw> orders = {{"submitted", {}}, {"back_to_front", {}}};
+    orders[0].stats.overdraw = 1.5;
+    orders[1].stats.overdraw = 3.0;
+    int ch = 0;
+    const std::vector<uint8_t> chart = renderOverdrawByOrder(orders, &ch);
+    EXPECT_EQ(chart.size(), size_t(kOverdrawChartWidth) * size_t(ch) * 3);
+
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "visaudit_ordering_images";
+    std::filesystem::create_directories(dir);
+    const OrderingImageNames names = orderingImageNames((dir / "v").string());
+    std::string err;
+    EXPECT_TRUE(writePainterErrorsImage(ref, p, names.painterErrorsPng, &err)) << err;
+    EXPECT_TRUE(writeOverdrawByOrderChart(orders, names.overdrawOrderPng, &err)) << err;
+    EXPECT_TRUE(std::filesystem::file_size(names.painterErrorsPng) > 0);
+    EXPECT_FALSE(writeABufferImage(ABufferResult{}, names.abufferPng, &err));
+    EXPECT_EQ(err, "cannot write image '" + names.abufferPng + "': the A-buffer did not run for this view");
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace va
