@@ -62,6 +62,7 @@ struct Options {
     double nearZ = 0, farZ = 0;
     std::string formats;  // comma-separated; empty = all
     std::string auditOut; // empty = console only
+    std::string auditScene; // depth-audit --scene
     std::string shard;    // analyze --shard K/N
     std::vector<std::string> mergeDirs;
     // check
@@ -442,9 +443,54 @@ void addMergeOptions(CLI::App *c, Options &o) {
     c->add_flag("--quiet", o.quiet, "No summary on the console");
 }
 
+// depth-audit --scene: the per-view z-fighting analysis over a scene's views, with the formats'
+// verdicts and the recommendation per view (no images, no report folder).
+int depthAuditScene(const Options &o, const std::vector<DepthFormat> &formats) {
+    Options lo = o;
+    lo.scene = o.auditScene;
+    Scene scene;
+    std::vector<ViewSpec> views;
+    if (!loadInputs(lo, &scene, &views)) return kExitBadInput;
+    PipelineSettings s;
+    s.audit = s.raycast = s.detail = s.occlusion = false;
+    s.zfightSettings.formats = formats;
+    s.threads = o.threads;
+    AnalysisResult result;
+    std::string err;
+    if (!analyzeScene(scene, views, s, nullptr, &result, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    std::printf("z-fighting per view of %s (pixels whose two nearest surfaces fight; coplanar ones in brackets)\n",
+                scene.path.c_str());
+    for (const ViewResult &v : result.views) {
+        const ZFightResult &z = v.zfight;
+        std::printf("view '%s' %dx%d, near %g, far %g, its format %s: %llu hotspots\n", v.spec.name.c_str(),
+                    v.camera.width, v.camera.height, v.camera.nearZ, v.camera.farZ,
+                    depthFormatInfo(v.spec.depthFormat).name, (unsigned long long)z.hotspotCount);
+        for (const ZFightFormatStats &f : z.perFormat)
+            std::printf("  %-18s %2d bits %10llu fighting [%llu]%s\n", f.name.c_str(), f.bits,
+                        (unsigned long long)f.fightingPixels, (unsigned long long)f.coplanarPixels,
+                        z.recommended && *z.recommended == f.format ? "   <- recommended" : "");
+        for (size_t k = 0; k < z.hotspots.size() && k < 3; ++k) {
+            const ZFightHotspot &h = z.hotspots[k];
+            std::printf("  hotspot %u: %llu px at world (%.3g, %.3g, %.3g), '%s' vs '%s', gap %.3g\n", h.id,
+                        (unsigned long long)h.area, h.centroid.x, h.centroid.y, h.centroid.z, h.objectA.c_str(),
+                        h.objectB.c_str(), h.depthGap);
+        }
+        std::printf("  %s\n", z.recommendation.c_str());
+    }
+    return kExitOk;
+}
+
 int cmdDepthAudit(const Options &o) {
     std::string err;
-    if (!validateDepthAuditRange(o.nearZ, o.farZ, &err)) {
+    const bool range = o.nearZ != 0 || o.farZ != 0;
+    if (!range && o.auditScene.empty()) {
+        fail("depth-audit needs --near N --far F (the formats over a depth range), --scene SCENE (its views), or both");
+        return kExitBadInput;
+    }
+    if (range && !validateDepthAuditRange(o.nearZ, o.farZ, &err)) {
         fail(err);
         return kExitBadInput;
     }
@@ -463,6 +509,7 @@ int cmdDepthAudit(const Options &o) {
             formats.push_back(f);
         }
     }
+    if (!range) return depthAuditScene(o, formats);
     const DepthAuditResult r = auditDepthFormats(o.nearZ, o.farZ, formats);
     if (!r.error.empty()) {
         fail(r.error);
@@ -484,12 +531,16 @@ int cmdDepthAudit(const Options &o) {
         }
         std::printf("wrote %s/depth-audit.json and %s/depth-audit.png\n", o.auditOut.c_str(), o.auditOut.c_str());
     }
+    if (!o.auditScene.empty()) return depthAuditScene(o, formats);
     return kExitOk;
 }
 
 void addDepthAuditOptions(CLI::App *c, Options &o) {
-    c->add_option("--near", o.nearZ, "Near plane distance (> 0)")->required();
-    c->add_option("--far", o.farZ, "Far plane distance (> near)")->required();
+    c->add_option("--near", o.nearZ, "Near plane distance (> 0)");
+    c->add_option("--far", o.farZ, "Far plane distance (> near)");
+    c->add_option("--scene", o.auditScene, "Also analyse this scene's views: per view, where each format z-fights "
+                                           "and the recommended format");
+    c->add_option("--views", o.views, "With --scene: a views file, orbit:N, spawns or walk:N");
     c->add_option("--formats", o.formats, "Comma-separated depth formats (default: all)");
     c->add_option("--out", o.auditOut, "Folder for depth-audit.json and depth-audit.png");
 }

@@ -441,3 +441,25 @@ TEST_F(CliTest, JsonSummaryOnStdoutAndPlainProgressLinesWithoutATerminal) {
     EXPECT_NE(r.err.find("[1/2] "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("[2/2] "), std::string::npos) << r.err;
 }
+
+TEST_F(CliTest, DepthAuditSceneRecommendsAFormatPerView) {
+    // A floor and a decal 1 mm above it, seen from 100 m (near 0.1, far 1000): unorm16 cannot
+    // separate them there, so the recommendation needs more bits; the hall fights nowhere.
+    std::ofstream(dir_ / "floor.obj") << "v -60 0 -60\nv 60 0 -60\nv 60 0 60\nv -60 0 60\nf 1 4 3 2\n";
+    std::ofstream(dir_ / "decal.obj") << "v -20 0.001 -20\nv 20 0.001 -20\nv 20 0.001 20\nv -20 0.001 20\nf 1 4 3 2\n";
+    std::ofstream(dir_ / "decal.scene.json") << R"({"format": "visaudit-scene/1",
+      "objects": [{"name": "floor", "mesh": "floor.obj"}, {"name": "decal", "mesh": "decal.obj"}],
+      "views": [{"name": "far", "eye": [0, 60, 80], "target": [0, 0, 0], "near": 0.1, "far": 1000,
+                 "width": 160, "height": 90, "depth_format": "unorm16"}]})";
+    const RunResult r = run("depth-audit --scene " + (dir_ / "decal.scene.json").string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("view 'far' 160x90, near 0.1, far 1000, its format unorm16"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("hotspot 1: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("'floor' vs 'decal'"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("unorm16            16 bits          0 fighting"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("f32_reversed       32 bits          0 fighting [0]"), std::string::npos) << r.out;
+    // Neither a range nor a scene: exit 2.
+    const RunResult bad = run("depth-audit");
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("depth-audit needs --near N --far F"), std::string::npos) << bad.err;
+}
