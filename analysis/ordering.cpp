@@ -390,10 +390,12 @@ ABufferResult abufferForView(const OrderingView &v) {
     const size_t n = scene.triangleCount();
     std::vector<float> alpha(n, 1.0f);
     std::vector<uint8_t> rgb(3 * n, 255);
+    std::vector<uint32_t> surface(n, UINT32_MAX);
     for (size_t t = 0; t < n; ++t) {
         const uint32_t o = scene.triangleObject[t];
         if (o == kExcludedTriangle) continue;
         const SceneObject &ob = scene.objects[o];
+        surface[t] = ob.source;  // a source object (one mesh, one material) is one surface
         alpha[t] = float(std::clamp(scene.materials[ob.material].alpha, 0.0, 1.0));
         // A fixed color per source object: a multiplicative hash of its index, kept bright.
         const uint32_t h = (ob.source + 1) * 2654435761u;
@@ -405,6 +407,7 @@ ABufferResult abufferForView(const OrderingView &v) {
     m.alpha = alpha.data();
     m.rgb = rgb.data();
     m.singleSided = v.singleSided.data();
+    m.surface = surface.data();
     m.background[0] = m.background[1] = m.background[2] = 24;
     return resolveABuffer(v.all, v.cam.width, v.cam.height, v.cam.orthographic, m);
 }

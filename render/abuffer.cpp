@@ -74,6 +74,12 @@ ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height,
     r.rgb.assign(pixels * 3, 0);
     r.edge.assign(pixels, 0);
 
+    // Surface of a visible id (1 + source; 0 background -> a value no surface has).
+    auto surfaceOf = [&](uint32_t id) -> uint64_t {
+        if (id == 0) return UINT64_MAX;
+        return mat.surface ? mat.surface[id - 1] : id - 1;
+    };
+
     // Resolve per pixel.
     struct Entry {
         double d;
@@ -114,7 +120,7 @@ ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height,
                 return a.d < b.d || (a.d == b.d && a.source < b.source);
             });
             const uint32_t visible = list.empty() ? 0 : list.front().source + 1;
-            if (visible != centerId[p]) edge = true;
+            if (surfaceOf(visible) != surfaceOf(centerId[p])) edge = true;
             double T = 1;
             for (const Entry &e : list) {
                 const ABufferFragment &f = pool[e.frag];

@@ -45,6 +45,9 @@ struct ABufferMaterials {
     const float *alpha = nullptr;        // per source triangle, 0..1 (1 opaque)
     const uint8_t *rgb = nullptr;        // per source triangle, 3 bytes
     const uint8_t *singleSided = nullptr;// per source triangle: drawn only with the front winding
+    const uint32_t *surface = nullptr;   // per source triangle: the surface it belongs to (edge pixels
+                                         //   compare surfaces, so a mesh's inner edges do not count);
+                                         //   null: every triangle is its own surface
     uint8_t background[3] = {0, 0, 0};
 };
 
@@ -67,9 +70,10 @@ struct ABufferResult {
     std::vector<uint64_t> listHistogram;  // [k] = pixels with k fragments (k < kABufferHistogramMax; last: >=)
     uint64_t memoryBytes = 0;         // fragment pool + per-pixel list heads
     uint64_t transparentFragments = 0;// fragments with alpha < 1
-    // Edge pixels: the z-buffer's single center sample shows one triangle (the nearest covering the
-    // center), while the A-buffer's visible surface (nearest at each sub-sample) is a different one
-    // at one sub-sample or more: the pixel's coverage is partial, and the z-buffer's is wrong there.
+    // Edge pixels: the z-buffer's single center sample shows one surface (that of the nearest
+    // triangle covering the center; ABufferMaterials::surface), while the A-buffer's visible surface
+    // (nearest at each sub-sample) is a different one -- or background -- at one sub-sample or more:
+    // the pixel's coverage is partial, and the z-buffer's one sample misrepresents it.
     uint64_t edgePixels = 0;
     std::vector<uint8_t> edge;        // per pixel, 1 for an edge pixel
     std::vector<uint8_t> rgb;         // the composite (interleaved RGB8, row-major)

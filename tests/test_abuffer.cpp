@@ -120,9 +120,12 @@ TEST(ABuffer, CompositeFrontToBack) {
     EXPECT_EQ(r.memoryBytes, 220 * sizeof(ABufferFragment) + 256 * sizeof(uint32_t));
     // The squares' outer edges lie on pixel boundaries (no partial pixel); the 10 pixels on the
     // shared diagonal hold sub-samples of both triangles of a square (the diagonal runs through
-    // their centers and through the samples with i == j): the center's one triangle is not what
-    // every sub-sample shows, so they count as edge pixels (edges between triangles, not objects).
+    // their centers and through the samples with i == j): with every triangle its own surface they
+    // are edge pixels; with one surface per square they are not.
     EXPECT_EQ(r.edgePixels, 10u);
+    const uint32_t surface[4] = {0, 0, 1, 1};
+    m.surface = surface;
+    EXPECT_EQ(resolveABuffer(st, 16, 16, true, m).edgePixels, 0u);
 }
 
 // The planner: the hall has glass (the A-buffer runs), the demo has no transparent material.
