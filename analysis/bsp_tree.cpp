@@ -161,16 +161,16 @@ struct Builder {
     }
 
     void build(std::vector<uint32_t> rootList) {
+        // A node to build: its pieces, its parent (by index: `nodes` reallocates) and which child.
         struct Work {
-            int32_t *slot;        // where the new node's index goes (parent's child field), or null for the root
-            int32_t parent;       // parent node (to re-find the slot after nodes reallocates)
+            int32_t parent;       // -1 for the root
             bool frontChild;
             std::vector<uint32_t> list;
             uint32_t depth;
         };
         std::vector<Work> stack;
         if (rootList.empty()) return;
-        stack.push_back({nullptr, -1, false, std::move(rootList), 1});
+        stack.push_back({-1, false, std::move(rootList), 1});
         uint64_t leafDepthSum = 0, leaves = 0;
         std::vector<int> sides;
         while (!stack.empty()) {
@@ -211,8 +211,8 @@ struct Builder {
                 leafDepthSum += w.depth;
                 ++leaves;
             }
-            if (!back.empty()) stack.push_back({nullptr, int32_t(node), false, std::move(back), w.depth + 1});
-            if (!front.empty()) stack.push_back({nullptr, int32_t(node), true, std::move(front), w.depth + 1});
+            if (!back.empty()) stack.push_back({int32_t(node), false, std::move(back), w.depth + 1});
+            if (!front.empty()) stack.push_back({int32_t(node), true, std::move(front), w.depth + 1});
         }
         tree.stats.averageLeafDepth = leaves ? double(leafDepthSum) / double(leaves) : 0;
     }
@@ -271,7 +271,6 @@ BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles,
         list.push_back(uint32_t(tree.pieces.size()));
         tree.pieces.push_back(p);
     }
-    const size_t inputPieces = tree.pieces.size();
     b.build(std::move(list));
 
     // Stats: the pieces that ended in nodes are the tree's pieces (split parents are not).
@@ -289,7 +288,6 @@ BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles,
         }
     }
     for (uint8_t s : splitSource) st.splitSources += s;
-    (void)inputPieces;
     st.predicateCalls = b.predicates;
     st.memoryBytes = tree.nodes.size() * sizeof(BspTreeNode) + tree.pieces.size() * sizeof(BspPiece) +
                      tree.nodePieces.size() * sizeof(uint32_t) + tree.vertices.size() * sizeof(Vec3) +
