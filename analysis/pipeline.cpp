@@ -46,6 +46,15 @@ bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *
     PreparedScene ps = prepareScene(scene);
     ps.effects = planEffects(scene, s.effects);
     if (s.grid && !gridSkipReason(scene)) ps.grid = buildGrid(scene, s.gridSettings);
+    const uint64_t tris = scene.objectTriangles.size();
+    if (!s.ordering || !s.audit) {
+        ps.orderingReason = !s.ordering ? "turned off by --no-ordering" : "needs the reference visibility (--no-audit)";
+    } else if (tris > s.orderingMaxTriangles) {
+        ps.orderingReason = "scene has " + std::to_string(tris) + " triangles, more than --ordering-max-triangles " +
+                            std::to_string(s.orderingMaxTriangles) + " (the BSP tree can grow quadratically)";
+    } else {
+        ps.bspTree = std::make_unique<BspTree>(buildBspTree(scene));
+    }
     if (s.raycast) {
         const auto t0 = Clock::now();
         ps.rays = std::make_unique<RayScene>();
@@ -326,6 +335,15 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         r.auditReason = "turned off by --no-audit";
     }
 
+    // Audit: draw orders against the reference -- painter's, BSP, scanline, overdraw by order, and
+    // the A-buffer where the scene has transparency.
+    if (ps.bspTree && r.auditRan) {
+        r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer);
+        r.orderingRan = true;
+    } else {
+        r.orderingReason = ps.orderingReason.empty() ? "needs the reference visibility" : ps.orderingReason;
+    }
+
     // Audit: detail -- triangles drawn against the pixels they show, too small, over-detailed.
     if (s.detail) {
         r.detail = auditDetail(scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
@@ -370,6 +388,11 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
     out->effects = ps.effects;
     out->raycast = ps.rays != nullptr;
     out->raySceneBuildMs = ps.raySceneBuildMs;
+    out->orderingReason = ps.orderingReason;
+    if (ps.bspTree) {
+        out->bspTreeBuilt = true;
+        out->bspTree = ps.bspTree->stats;
+    }
     for (const Light &l : scene.lights) out->lightNames.push_back(l.name);
     if (scene.bsp) {
         AnalysisResult::BspSummary b;

@@ -15,6 +15,7 @@
 #include "analysis/detail.h"
 #include "analysis/grid.h"
 #include "analysis/occlusion.h"
+#include "analysis/bsp_tree.h"
 #include "analysis/portals.h"
 #include "analysis/effects_plan.h"
 #include "render/raycast.h"
@@ -35,6 +36,9 @@ struct PipelineSettings {
     bool frustum = true;   // --no-frustum turns the stage off
     bool occlusion = true; // --no-occlusion turns the stage off
     OcclusionSettings occlusionSettings; // --occluders
+    bool ordering = true;  // --no-ordering turns the draw-order audit (painter's, BSP, scanline, A-buffer) off
+    uint64_t orderingMaxTriangles = 200000;  // above it the ordering audit is skipped (the BSP tree can
+                                             // grow quadratically): --ordering-max-triangles
     bool detail = true;    // --no-detail turns the detail audit off
     DetailSettings detailSettings;      // --detail-min-pixels, --detail-triangles-per-pixel
     bool backface = true;  // --no-backface turns the stage off
@@ -55,6 +59,8 @@ struct PreparedScene {
     const Scene *scene = nullptr;
     ObjectBvh bvh;
     Grid grid;                       // when the grid stage can run (gridSkipReason is null)
+    std::unique_ptr<BspTree> bspTree; // the ordering audit's BSP tree (view-independent)
+    std::string orderingReason;      // why the ordering audit does not run (empty: it does)
     std::unique_ptr<RayScene> rays;  // Embree scene over every analysed triangle (raycast on)
     double raySceneBuildMs = 0;
     SceneEffectsData effectsData;

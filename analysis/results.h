@@ -13,6 +13,7 @@
 #include "analysis/detail.h"
 #include "analysis/grid.h"
 #include "analysis/occlusion.h"
+#include "analysis/ordering.h"
 #include "analysis/portals.h"
 #include "analysis/effects_plan.h"
 #include "analysis/scene.h"
@@ -69,6 +70,9 @@ struct ViewResult {
     std::string cellsNote;            // e.g. the camera is in the void
     GridStats grid;                   // the grid stage, when it ran
     OcclusionStats occlusion;         // the occlusion stage, when it ran
+    bool orderingRan = false;         // draw orders and exact orders (docs/ordering.md)
+    std::string orderingReason;       // why it did not run
+    OrderingResult ordering;
     bool detailRan = false;           // the detail audit (docs/coarse-stages.md)
     DetailResult detail;
     // The raycast stage: Embree primary rays at pixel centers over the whole scene (no culling),
@@ -115,6 +119,9 @@ struct AnalysisResult {
     std::optional<BspSummary> bsp;
     bool raycast = false;             // whether the raycast stage ran
     double raySceneBuildMs = 0;       // Embree BVH build over the scene (once, for every view)
+    bool bspTreeBuilt = false;        // the ordering audit's BSP tree (once, view-independent)
+    BspStats bspTree;
+    std::string orderingReason;       // why the ordering audit did not run (empty: it ran)
     // --shard K/N: this report holds the views whose index i has i % N == K - 1.
     struct Shard {
         int index = 1, count = 1;     // K and N (1-based K); 1/1 = every view

@@ -49,7 +49,8 @@ struct Options {
     uint32_t chunk = 512;
     bool noBackface = false, noFrustum = false, noZFight = false, noAudit = false, noCells = false, noRaycast = false;
     int patchLevel = 5;
-    bool noGrid = false, noOcclusion = false, noDetail = false;
+    bool noGrid = false, noOcclusion = false, noDetail = false, noOrdering = false;
+    uint64_t orderingMaxTriangles = 200000;
     double gridCell = 0, detailMinPixels = 4, detailTrianglesPerPixel = 1;
     uint32_t occluders = 16, portalDepth = 64;
     // Effects: unset = the scene decides.
@@ -129,6 +130,8 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->occlusion = !o.noOcclusion;
     s->occlusionSettings.maxOccluders = o.occluders;
     s->detail = !o.noDetail;
+    s->ordering = !o.noOrdering;
+    s->orderingMaxTriangles = o.orderingMaxTriangles;
     s->detailSettings.minPixels = o.detailMinPixels;
     s->detailSettings.trianglesPerPixel = o.detailTrianglesPerPixel;
     s->raycast = !o.noRaycast;
@@ -243,6 +246,13 @@ int analyzeToReport(const Options &o,
         v.imageBase = bases[i];
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
         v.buffer = ZBuffer{};  // the images hold it now
+        v.ordering.painter.id = {};
+        v.ordering.painter.cls = {};
+        v.ordering.bsp.id = {};
+        v.ordering.bsp.cls = {};
+        v.ordering.scanline.id = {};
+        v.ordering.abuffer.rgb = {};
+        v.ordering.abuffer.edge = {};
         v.reference.id = {};
         v.reference.depth = {};
         v.reference.pixelsOf = {};
@@ -577,6 +587,10 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-occlusion", o.noOcclusion, "Turn the occlusion stage off");
     c->add_option("--occluders", o.occluders, "Occluders drawn in the occlusion pre-pass")->check(CLI::Range(0u, 100000u));
     c->add_flag("--no-detail", o.noDetail, "Turn the detail audit off");
+    c->add_flag("--no-ordering", o.noOrdering, "Turn the draw-order audit (painter's, BSP tree, scanline, A-buffer) off");
+    c->add_option("--ordering-max-triangles", o.orderingMaxTriangles,
+                  "Largest scene the draw-order audit runs on (its BSP tree can grow quadratically)")
+        ->check(CLI::Range(uint64_t(0), uint64_t(1) << 40));
     c->add_option("--detail-min-pixels", o.detailMinPixels, "Detail audit: objects projected smaller are too small")
         ->check(CLI::Range(0.0, 1e9));
     c->add_option("--detail-triangles-per-pixel", o.detailTrianglesPerPixel,

@@ -25,6 +25,7 @@
 #include "reports/report.h"
 #include "reports/audit_images.h"
 #include "reports/effects_images.h"
+#include "reports/ordering_images.h"
 #include "reports/zfight_image.h"
 
 namespace va {
@@ -263,6 +264,15 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     // BASE.culling.png: the reference visibility colored by each pixel's fate (reports/audit_images.h).
     if (view.auditRan && !writeCullingImage(view.reference, view.cullAudit, prefix + names.cullingPng, err))
         return false;
+    // Draw orders: painter's errors, overdraw by order, the A-buffer composite (reports/ordering_images.h).
+    if (view.orderingRan) {
+        const OrderingImageNames on = orderingImageNames(names.base);
+        if (!writePainterErrorsImage(view.reference, view.ordering.painter, prefix + on.painterErrorsPng, err) ||
+            !writeOverdrawByOrderChart(view.ordering.overdrawByOrder, prefix + on.overdrawOrderPng, err))
+            return false;
+        if (view.ordering.abufferRan && !writeABufferImage(view.ordering.abuffer, prefix + on.abufferPng, err))
+            return false;
+    }
     // The raycast stage: its ids, and where it disagrees with the z-buffer (reports/audit_images.h).
     if (view.raycastRan) {
         if (!writeRaycastIds(view.raycastImage.width, view.raycastImage.height, view.raycastImage.id,

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "reports/ordering_images.h"
 #include "reports/report.h"
 
 namespace va {
@@ -239,6 +240,88 @@ Json detailJson(const DetailResult &d) {
                            {"triangles_saved", o.trianglesSaved}});
     j["flagged"] = flagged;
     j["ms"] = num(d.ms);
+    return j;
+}
+
+Json drawStatsJson(const DrawStats &d) {
+    return {{"fragments", d.fragments},     {"depth_passes", d.depthPasses},
+            {"covered_pixels", d.coveredPixels}, {"overdraw", num(d.overdraw)},
+            {"depth_complexity", num(d.depthComplexity)}, {"ms", num(d.ms)}};
+}
+
+// Draw orders and exact orders (analysis/ordering.h; docs/ordering.md).
+Json orderingJson(const OrderingResult &o) {
+    Json j;
+    j["ran"] = true;
+    Json table = Json::array();
+    for (const OrderingRow &r : o.table)
+        table.push_back({{"method", r.method},
+                         {"build_ms", num(r.buildMs)},
+                         {"draw_ms", num(r.drawMs)},
+                         {"wrong_pixels", r.wrongPixels},
+                         {"tie_pixels", r.tiePixels},
+                         {"edge_pixels", r.edgePixels},
+                         {"overdraw", num(r.overdraw)},
+                         {"memory_bytes", r.memoryBytes}});
+    j["table"] = table;
+    const PainterResult &p = o.painter;
+    const OverlapTests &t = p.overlaps;
+    j["painter"] = {{"key", painterKeyName(p.key)},
+                    {"triangles_drawn", p.trianglesDrawn},
+                    {"fragments", p.fragments},
+                    {"covered_pixels", p.coveredPixels},
+                    {"wrong_pixels", p.wrongPixels},
+                    {"tie_pixels", p.tiePixels},
+                    {"edge_pixels", p.edgePixels},
+                    {"overlaps",
+                     {{"pairs", t.pairs},
+                      {"bounds_disjoint", t.boundsDisjoint},
+                      {"behind_plane", t.behindPlane},
+                      {"in_front_of_plane", t.inFrontOfPlane},
+                      {"projections_disjoint", t.projectionsDisjoint},
+                      {"unresolved", t.unresolved},
+                      {"swapped", t.swapped},
+                      {"ms", num(t.ms)}}}};
+    j["bsp"] = {{"pieces_drawn", o.bsp.piecesDrawn},
+                {"wrong_pixels", o.bsp.wrongPixels},
+                {"tie_pixels", o.bsp.tiePixels},
+                {"edge_pixels", o.bsp.edgePixels},
+                {"back_to_front", drawStatsJson(o.bsp.backToFront)},
+                {"front_to_back", drawStatsJson(o.bsp.frontToBack)},
+                {"traverse_ms", num(o.bsp.traverseMs)}};
+    Json byOrder = Json::array();
+    for (const OrderOverdraw &d : o.overdrawByOrder) {
+        Json e = drawStatsJson(d.stats);
+        e["order"] = d.order;
+        byOrder.push_back(e);
+    }
+    j["overdraw_by_order"] = byOrder;
+    const ScanlineResult &sc = o.scanline;
+    j["scanline"] = {{"wrong_pixels", o.scanlineWrongPixels},
+                     {"tie_pixels", o.scanlineTiePixels},
+                     {"edge_pixels", o.scanlineEdgePixels},
+                     {"spans", sc.spans},
+                     {"max_active_triangles", sc.maxActiveTriangles},
+                     {"memory_bytes", sc.memoryBytes},
+                     {"zbuffer_bytes", sc.zbufferBytes}};
+    if (o.abufferRan) {
+        const ABufferResult &a = o.abuffer;
+        Json hist = Json::array();
+        for (uint64_t h : a.listHistogram) hist.push_back(h);
+        j["abuffer"] = {{"ran", true},
+                        {"fragments", a.fragments},
+                        {"covered_pixels", a.coveredPixels},
+                        {"average_list_length", num(a.averageListLength)},
+                        {"max_list_length", a.maxListLength},
+                        {"list_histogram", hist},
+                        {"memory_bytes", a.memoryBytes},
+                        {"transparent_fragments", a.transparentFragments},
+                        {"edge_pixels", a.edgePixels},
+                        {"ms", num(a.ms)}};
+    } else {
+        j["abuffer"] = {{"ran", false}, {"reason", o.abufferReason}};
+    }
+    j["ms"] = num(o.ms);
     return j;
 }
 
@@ -479,8 +562,28 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
     j["load_ms"] = num(r.loadMs);
     Json decisions = Json::array();
     for (const EffectDecision &d : r.effects.all())
-        decisions.push_back({{"name", d.name}, {"ran", d.run && (d.name != "abuffer")}, {"called_for", d.run},
+        decisions.push_back({{"name", d.name},
+                             {"ran", d.run && (d.name == "abuffer" ? r.bspTreeBuilt : r.raycast)},
+                             {"called_for", d.run},
                              {"forced", d.forced}, {"reason", d.reason}, {"triangles", d.triangles}});
+    if (r.bspTreeBuilt) {
+        const BspStats &b = r.bspTree;
+        j["bsp_tree"] = {{"ran", true},
+                         {"triangles_in", b.trianglesIn},
+                         {"pieces", b.pieces},
+                         {"triangles_out", b.trianglesOut},
+                         {"splits", b.splits},
+                         {"split_sources", b.splitSources},
+                         {"degenerate_pieces", b.degeneratePieces},
+                         {"nodes", b.nodes},
+                         {"depth", b.depth},
+                         {"average_leaf_depth", num(b.averageLeafDepth)},
+                         {"predicate_calls", b.predicateCalls},
+                         {"build_ms", num(b.buildMs)},
+                         {"memory_bytes", b.memoryBytes}};
+    } else {
+        j["bsp_tree"] = {{"ran", false}, {"reason", r.orderingReason}};
+    }
     j["effects"] = {{"raycast", r.raycast},
                     {"ray_scene_build_ms", num(r.raySceneBuildMs)},
                     {"max_depth", r.effects.maxDepth},
@@ -512,6 +615,10 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
             vj["raycast"] = raycastJson(v, r.lightNames);
         else
             vj["raycast"] = {{"ran", false}, {"reason", "turned off by --no-raycast"}};
+        if (v.orderingRan)
+            vj["ordering"] = orderingJson(v.ordering);
+        else
+            vj["ordering"] = {{"ran", false}, {"reason", v.orderingReason}};
         if (v.detailRan)
             vj["detail"] = detailJson(v.detail);
         else
@@ -530,6 +637,12 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
                         {"ids_exr", names.idsExr}};
         if (v.zfightRan) vj["images"]["zfight_png"] = names.zfightPng;
         if (v.auditRan) vj["images"]["culling_png"] = names.cullingPng;
+        if (v.orderingRan) {
+            const OrderingImageNames on = orderingImageNames(names.base);
+            vj["images"]["painter_errors_png"] = on.painterErrorsPng;
+            vj["images"]["overdraw_order_png"] = on.overdrawOrderPng;
+            if (v.ordering.abufferRan) vj["images"]["abuffer_png"] = on.abufferPng;
+        }
         if (v.raycastRan) {
             vj["images"]["raycast_ids_exr"] = names.raycastIdsExr;
             vj["images"]["raycast_diff_png"] = names.raycastDiffPng;

@@ -281,12 +281,13 @@ TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
         EXPECT_EQ(slurp(e.path()), slurp(dir_ / "merged" / e.path().filename())) << e.path();
     }
     // Exactly the images the report lists: per view depth.exr, depth.png, overdraw.png, ids.exr,
-    // zfight.png, culling.png, raycast.ids.exr, raycast_diff.png, secondary.png and one shadow
-    // image per light (the hall has two lights).
+    // zfight.png, culling.png, raycast.ids.exr, raycast_diff.png, secondary.png, one shadow image
+    // per light (the hall has two lights), painter_errors.png, overdraw_order.png and abuffer.png
+    // (the hall has glass).
     size_t listed = 0;
     for (const auto &v : single["views"])
         for (const auto &[k, x] : v["images"].items()) listed += x.is_array() ? x.size() : 1;
-    EXPECT_EQ(listed, 9u * 11u);
+    EXPECT_EQ(listed, 9u * 14u);
     EXPECT_EQ(images, listed);
     // Missing and overlapping shards are refused.
     RunResult bad = run("merge " + (dir_ / "shard1").string() + " " + (dir_ / "shard2").string() + " --out " +
