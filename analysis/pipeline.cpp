@@ -338,7 +338,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // Audit: draw orders against the reference -- painter's, BSP, scanline, overdraw by order, and
     // the A-buffer where the scene has transparency.
     if (ps.bspTree && r.auditRan) {
-        r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer);
+        r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer, s.orderingSettings);
         r.orderingRan = true;
     } else {
         r.orderingReason = ps.orderingReason.empty() ? "needs the reference visibility" : ps.orderingReason;

@@ -16,6 +16,7 @@
 #include "analysis/grid.h"
 #include "analysis/occlusion.h"
 #include "analysis/bsp_tree.h"
+#include "analysis/ordering.h"
 #include "analysis/portals.h"
 #include "analysis/effects_plan.h"
 #include "render/raycast.h"
@@ -37,6 +38,7 @@ struct PipelineSettings {
     bool occlusion = true; // --no-occlusion turns the stage off
     OcclusionSettings occlusionSettings; // --occluders
     bool ordering = true;  // --no-ordering turns the draw-order audit (painter's, BSP, scanline, A-buffer) off
+    OrderingSettings orderingSettings;  // --painter-key
     uint64_t orderingMaxTriangles = 200000;  // above it the ordering audit is skipped (the BSP tree can
                                              // grow quadratically): --ordering-max-triangles
     bool detail = true;    // --no-detail turns the detail audit off

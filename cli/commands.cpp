@@ -51,6 +51,7 @@ struct Options {
     int patchLevel = 5;
     bool noGrid = false, noOcclusion = false, noDetail = false, noOrdering = false;
     uint64_t orderingMaxTriangles = 200000;
+    std::string painterKey = "centroid";
     double gridCell = 0, detailMinPixels = 4, detailTrianglesPerPixel = 1;
     uint32_t occluders = 16, portalDepth = 64;
     // Effects: unset = the scene decides.
@@ -132,6 +133,9 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->detail = !o.noDetail;
     s->ordering = !o.noOrdering;
     s->orderingMaxTriangles = o.orderingMaxTriangles;
+    s->orderingSettings.painterKey = o.painterKey == "nearest"    ? PainterKey::nearestVertex
+                                     : o.painterKey == "farthest" ? PainterKey::farthestVertex
+                                                                  : PainterKey::centroid;
     s->detailSettings.minPixels = o.detailMinPixels;
     s->detailSettings.trianglesPerPixel = o.detailTrianglesPerPixel;
     s->raycast = !o.noRaycast;
@@ -587,6 +591,8 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_flag("--no-occlusion", o.noOcclusion, "Turn the occlusion stage off");
     c->add_option("--occluders", o.occluders, "Occluders drawn in the occlusion pre-pass")->check(CLI::Range(0u, 100000u));
     c->add_flag("--no-detail", o.noDetail, "Turn the detail audit off");
+    c->add_option("--painter-key", o.painterKey, "Painter's algorithm sort key: centroid, nearest or farthest (vertex)")
+        ->check(CLI::IsMember({"centroid", "nearest", "farthest"}));
     c->add_flag("--no-ordering", o.noOrdering, "Turn the draw-order audit (painter's, BSP tree, scanline, A-buffer) off");
     c->add_option("--ordering-max-triangles", o.orderingMaxTriangles,
                   "Largest scene the draw-order audit runs on (its BSP tree can grow quadratically)")
