@@ -56,6 +56,25 @@ class CliTest : public ::testing::Test {
     fs::path dir_;
 };
 
+// The report without its timings ("ms" and "*_ms" keys), which differ between runs.
+nlohmann::json withoutTimings(nlohmann::json j) {
+    std::function<void(nlohmann::json &)> rec = [&](nlohmann::json &x) {
+        if (x.is_object()) {
+            for (auto it = x.begin(); it != x.end();) {
+                const std::string k = it.key();
+                if (k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0))
+                    it = x.erase(it);
+                else
+                    rec(*it++);
+            }
+        } else if (x.is_array()) {
+            for (auto &e : x) rec(e);
+        }
+    };
+    rec(j);
+    return j;
+}
+
 // The index of the stage named `name` in a view's "stages" (DESIGN.md's fixed order), or -1.
 int stageIndex(const nlohmann::json &view, const std::string &name) {
     for (size_t i = 0; i < view["stages"].size(); ++i)
@@ -98,26 +117,8 @@ TEST_F(CliTest, AnalyzeIsDeterministicAcrossThreadCounts) {
     ASSERT_EQ(run("analyze --quiet --threads 2 --out " + b.string()).code, 0);
     for (const char *f : {"spawn.ids.exr", "spawn.depth.exr", "overview.overdraw.png", "overview.ids.exr"})
         EXPECT_EQ(slurp(a / f), slurp(b / f)) << f;
-    auto strip = [](nlohmann::json j) {
-        // Timings differ between runs; everything else must not.
-        std::function<void(nlohmann::json &)> rec = [&](nlohmann::json &x) {
-            if (x.is_object()) {
-                for (auto it = x.begin(); it != x.end();) {
-                    const std::string k = it.key();
-                    if (k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0))
-                        it = x.erase(it);
-                    else
-                        rec(*it++);
-                }
-            } else if (x.is_array()) {
-                for (auto &e : x) rec(e);
-            }
-        };
-        rec(j);
-        return j;
-    };
-    EXPECT_EQ(strip(nlohmann::json::parse(slurp(a / "report.json"))),
-              strip(nlohmann::json::parse(slurp(b / "report.json"))));
+    EXPECT_EQ(withoutTimings(nlohmann::json::parse(slurp(a / "report.json"))),
+              withoutTimings(nlohmann::json::parse(slurp(b / "report.json"))));
 }
 
 TEST_F(CliTest, AnalyzeExampleSceneObjAndViewsFile) {
@@ -254,23 +255,8 @@ TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
                             (dir_ / "shard2").string() + " " + (dir_ / "shard4").string() + " --out " +
                             (dir_ / "merged").string());
     ASSERT_EQ(m.code, 0) << m.err;
-    std::function<void(nlohmann::json &)> strip = [&](nlohmann::json &x) {
-        if (x.is_object()) {
-            for (auto it = x.begin(); it != x.end();) {
-                const std::string k = it.key();
-                if (k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0))
-                    it = x.erase(it);
-                else
-                    strip(*it++);
-            }
-        } else if (x.is_array()) {
-            for (auto &e : x) strip(e);
-        }
-    };
-    auto single = nlohmann::json::parse(slurp(dir_ / "single" / "report.json"));
-    auto merged = nlohmann::json::parse(slurp(dir_ / "merged" / "report.json"));
-    strip(single);
-    strip(merged);
+    const auto single = withoutTimings(nlohmann::json::parse(slurp(dir_ / "single" / "report.json")));
+    const auto merged = withoutTimings(nlohmann::json::parse(slurp(dir_ / "merged" / "report.json")));
     EXPECT_EQ(single, merged);
     // Every image is byte-identical too.
     size_t images = 0;
