@@ -670,8 +670,28 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     std::vector<std::string> stageOrder;
     std::map<std::string, uint64_t> culled;
     uint64_t covered = 0, fragments = 0, passes = 0;
+    uint64_t falseTris = 0, falsePixels = 0, wastedTris = 0, wastedFragments = 0, genuine = 0, hotspots = 0;
+    std::map<std::string, uint64_t> falseByStage;
     double totalMs = 0;
+    // A count of a section that may be absent (a stage or audit that did not run) reads as 0.
+    auto count = [](const Json &j, std::initializer_list<const char *> path) -> uint64_t {
+        const Json *x = &j;
+        for (const char *k : path) {
+            if (!x->is_object() || !x->contains(k)) return 0;
+            x = &(*x)[k];
+        }
+        return x->is_number_unsigned() ? x->get<uint64_t>() : 0;
+    };
     for (const Json &v : views) {
+        falseTris += count(v, {"audit", "false_culls", "triangles"});
+        falsePixels += count(v, {"audit", "false_culls", "pixels"});
+        if (v.contains("audit") && v["audit"].contains("false_culls"))
+            for (const auto &[stage, st] : v["audit"]["false_culls"]["by_stage"].items())
+                falseByStage[stage] += count(st, {"false_cull_triangles"});
+        wastedTris += count(v, {"audit", "wasted_draws", "triangles"});
+        wastedFragments += count(v, {"audit", "wasted_draws", "fragments"});
+        genuine += count(v, {"raycast", "cross_check", "genuine"});
+        hotspots += count(v, {"depth", "hotspot_count"});
         for (const Json &s : v["stages"]) {
             const std::string name = s["name"];
             if (!culled.count(name)) stageOrder.push_back(name);
@@ -690,6 +710,16 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     totals["covered_pixels"] = covered;
     totals["fragments"] = fragments;
     totals["depth_passes"] = passes;
+    Json falseStages = Json::object();
+    for (const std::string &name : stageOrder)
+        if (falseByStage.count(name)) falseStages[name] = falseByStage[name];
+    totals["false_cull_triangles"] = falseTris;
+    totals["false_cull_pixels"] = falsePixels;
+    totals["false_cull_triangles_by_stage"] = falseStages;
+    totals["wasted_triangles"] = wastedTris;
+    totals["wasted_fragments"] = wastedFragments;
+    totals["genuine_disagreements"] = genuine;
+    totals["zfight_hotspots"] = hotspots;
     totals["total_ms"] = num(totalMs);
     return totals;
 }
