@@ -334,17 +334,14 @@ int cmdCheck(const Options &o) {
     nlohmann::ordered_json baseline;
     std::string err;
     if (!o.baseline.empty()) {
-        std::ifstream f(o.baseline, std::ios::binary);
-        std::stringstream ss;
-        ss << f.rdbuf();
-        if (!f) {
+        std::string detail;
+        const JsonRead r = readJsonDocument(o.baseline, &baseline, &detail);
+        if (r == JsonRead::unreadable) {
             fail("--baseline " + o.baseline + ": cannot be read; give the report.json of an earlier analyze run");
             return kExitBadInput;
         }
-        try {
-            baseline = nlohmann::ordered_json::parse(ss.str());
-        } catch (const std::exception &e) {
-            fail("--baseline " + o.baseline + ": not valid JSON (" + e.what() + ")");
+        if (r == JsonRead::invalid) {
+            fail("--baseline " + o.baseline + ": not valid JSON (" + detail + ")");
             return kExitBadInput;
         }
     }
@@ -381,18 +378,11 @@ void addCheckOptions(CLI::App *c, Options &o) {
 
 // Reads a JSON file for grade/check; false + message naming the file.
 bool readJsonFile(const std::string &what, const std::string &path, nlohmann::ordered_json *out, std::string *err) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        *err = what + " " + path + ": cannot be read";
-        return false;
-    }
-    std::stringstream ss;
-    ss << f.rdbuf();
-    try {
-        *out = nlohmann::ordered_json::parse(ss.str());
-    } catch (const std::exception &e) {
-        *err = what + " " + path + ": not valid JSON (" + e.what() + ")";
-        return false;
+    std::string detail;
+    switch (readJsonDocument(path, out, &detail)) {
+    case JsonRead::unreadable: *err = what + " " + path + ": cannot be read"; return false;
+    case JsonRead::invalid: *err = what + " " + path + ": not valid JSON (" + detail + ")"; return false;
+    case JsonRead::ok: break;
     }
     return true;
 }

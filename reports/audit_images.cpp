@@ -18,17 +18,6 @@ void put(std::vector<uint8_t> &rgb, int w, int x, int y, Rgb8 c) {
     p[2] = c.b;
 }
 
-// Nearest and farthest finite positive depth (the range of depthGray).
-void depthRange(const std::vector<double> &depth, double *lo, double *hi) {
-    *lo = INFINITY;
-    *hi = -INFINITY;
-    for (double d : depth)
-        if (std::isfinite(d) && d > 0) {
-            *lo = std::min(*lo, d);
-            *hi = std::max(*hi, d);
-        }
-}
-
 }  // namespace
 
 AuditImageNames auditImageNames(const std::string &baseName) {

@@ -14,17 +14,6 @@ namespace {
 constexpr Rgb8 kShadowed{40, 90, 220};
 constexpr Rgb8 kFacingAway{70, 70, 70};
 
-// Nearest and farthest finite positive depth of the view (the range of depthGray).
-void depthRange(const ZBuffer &zb, double *lo, double *hi) {
-    *lo = INFINITY;
-    *hi = -INFINITY;
-    for (double d : zb.depth)
-        if (std::isfinite(d) && d > 0) {
-            *lo = std::min(*lo, d);
-            *hi = std::max(*hi, d);
-        }
-}
-
 bool sizesMatch(const EffectsResult &fx, const ZBuffer &zb, const std::string &path, std::string *err) {
     if (fx.width == zb.width && fx.height == zb.height && zb.depth.size() == size_t(zb.width) * size_t(zb.height))
         return true;
@@ -40,7 +29,7 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
     if (!sizesMatch(fx, zb, path, err)) return false;
     const int W = zb.width, H = zb.height;
     double lo, hi;
-    depthRange(zb, &lo, &hi);
+    depthRange(zb.depth, &lo, &hi);
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     // A visible pixel is lit, shadowed or facing away; the ray caster's visibility decides which
     // pixels are visible, so lit = visible and neither of the other two.
@@ -71,7 +60,7 @@ bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::
     if (!sizesMatch(fx, zb, path, err)) return false;
     const int W = zb.width, H = zb.height;
     double lo, hi;
-    depthRange(zb, &lo, &hi);
+    depthRange(zb.depth, &lo, &hi);
     // Depth 1..8+ on the overdraw ramp; 0 (no secondary ray) shows the depth image dimmed.
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     int deepest = 0;

@@ -22,6 +22,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "reports/font.h"
+#include "reports/legend.h"
 #include "reports/report.h"
 #include "reports/audit_images.h"
 #include "reports/effects_images.h"
@@ -109,16 +110,6 @@ LegendLayout legendLayout(const std::vector<uint32_t> &values, int imageWidth) {
     return L;
 }
 
-void fillRect(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c) {
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-            uint8_t *p = &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3];
-            p[0] = c.r;
-            p[1] = c.g;
-            p[2] = c.b;
-        }
-}
-
 }  // namespace
 
 bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err) {
@@ -166,6 +157,16 @@ Rgb8 overdrawColor(uint32_t fragments, uint32_t cap) {
 //              gray = round(255 - t * (255 - kDepthPngFarGray)).
 // The nearest surface of the view is white, the farthest kDepthPngFarGray (kept above 0 so that the
 // farthest geometry is still distinguishable from the black background). dMin == dMax: all white.
+void depthRange(const std::vector<double> &depth, double *dMin, double *dMax) {
+    *dMin = INFINITY;
+    *dMax = -INFINITY;
+    for (double d : depth)
+        if (std::isfinite(d) && d > 0) {
+            *dMin = std::min(*dMin, d);
+            *dMax = std::max(*dMax, d);
+        }
+}
+
 uint8_t depthGray(double d, double dMin, double dMax) {
     if (!std::isfinite(d) || !(d > 0) || !(dMin > 0) || !std::isfinite(dMax)) return 0;
     double t = 0;
@@ -203,12 +204,8 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.depth.png: log-scaled gray between the view's nearest and farthest finite depth.
     {
-        double dMin = INFINITY, dMax = -INFINITY;
-        for (double d : zb.depth)
-            if (std::isfinite(d) && d > 0) {
-                dMin = std::min(dMin, d);
-                dMax = std::max(dMax, d);
-            }
+        double dMin, dMax;
+        depthRange(zb.depth, &dMin, &dMax);
         std::vector<uint8_t> gray(n);
         for (size_t i = 0; i < n; ++i) gray[i] = depthGray(zb.depth[i], dMin, dMax);
         ImageSpec spec(W, H, 1, TypeDesc::UINT8);

@@ -35,18 +35,13 @@ namespace {
 
 bool readReport(const std::string &dir, Json *out, std::string *err) {
     const std::string path = (fs::path(dir) / "report.json").string();
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
+    std::string detail;
+    switch (readJsonDocument(path, out, &detail)) {
+    case JsonRead::unreadable:
         *err = path + ": cannot be read; give the --out folder of an `analyze --shard K/N` run";
         return false;
-    }
-    std::stringstream ss;
-    ss << f.rdbuf();
-    try {
-        *out = Json::parse(ss.str());
-    } catch (const std::exception &e) {
-        *err = path + ": not valid JSON (" + e.what() + ")";
-        return false;
+    case JsonRead::invalid: *err = path + ": not valid JSON (" + detail + ")"; return false;
+    case JsonRead::ok: break;
     }
     if (!out->is_object() || !out->contains("format") || (*out)["format"] != kReportFormat) {
         *err = path + ": not a " + std::string(kReportFormat) + " report; merge joins reports of this visaudit version";

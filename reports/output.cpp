@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <system_error>
 
@@ -198,6 +200,21 @@ OutputDir::~OutputDir() {
         std::error_code ec;
         fs::remove_all(staging_, ec);
     }
+}
+
+JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, std::string *detail) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return JsonRead::unreadable;
+    std::stringstream ss;
+    ss << f.rdbuf();
+    if (!f && !f.eof()) return JsonRead::unreadable;
+    try {
+        *out = nlohmann::ordered_json::parse(ss.str());
+    } catch (const std::exception &e) {
+        if (detail) *detail = e.what();
+        return JsonRead::invalid;
+    }
+    return JsonRead::ok;
 }
 
 }  // namespace va

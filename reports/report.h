@@ -88,8 +88,16 @@ Rgb8 overdrawColor(uint32_t fragments, uint32_t cap);
 // maximum finite depth): dMin -> 255 (white), dMax -> kDepthPngFarGray, background -> 0.
 constexpr uint8_t kDepthPngFarGray = 40;
 uint8_t depthGray(double d, double dMin, double dMax);
+// The nearest and farthest finite positive depth of a view (depthGray's range): +inf / -inf when
+// nothing is drawn.
+void depthRange(const std::vector<double> &depth, double *dMin, double *dMax);
 
 // ---- Files and folders -----------------------------------------------------------------------
+// Reads and parses a JSON file (a report, a baseline, a submission). `unreadable`: the file cannot
+// be opened or read; `invalid`: not JSON, *detail gets the parser's message. Callers word the error.
+enum class JsonRead { ok, unreadable, invalid };
+JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, std::string *detail);
+
 // Writes a text file atomically (temporary name in the same folder, then rename).
 bool writeFileAtomic(const std::string &path, const std::string &contents, std::string *err);
 // Images written the same way (OpenImageIO, temporary name in the same folder, then rename), for
