@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_util.h"
 #include "analysis/audit.h"
 #include "analysis/bsp_tree.h"
 #include "analysis/demo.h"
@@ -17,21 +18,7 @@
 namespace va {
 namespace {
 
-// A scene of loose triangles (one object each), one material.
-Scene triangleScene(const std::vector<std::array<Vec3, 3>> &tris, bool doubleSided = false) {
-    SceneBuildInput in;
-    Material m;
-    m.doubleSided = doubleSided;
-    in.materials = {m};
-    for (size_t i = 0; i < tris.size(); ++i) {
-        SceneBuildInput::Object o;
-        o.name = "t" + std::to_string(i);
-        o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
-        o.geometry.indices = {0, 1, 2};
-        in.objects.push_back(std::move(o));
-    }
-    return buildScene(std::move(in));
-}
+using testing_util::looseTriangles;
 
 // Three thin triangles ("sticks") around the z axis, each rotated 120 degrees from the last, each
 // rising along its length (z = 0.3 x in its own frame). The sticks' lines are the sides of an
@@ -100,11 +87,11 @@ TEST(BspTree, Orient3dSignAndExactness) {
 }
 
 TEST(BspTree, EmptyAndSingle) {
-    const Scene empty = triangleScene({});
+    const Scene empty = looseTriangles({});
     const BspTree t0 = buildBspTree(empty);
     EXPECT_EQ(t0.nodes.size(), 0u);
     EXPECT_TRUE(bspBackToFront(t0, empty, topCamera()).empty());
-    const Scene one = triangleScene({{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}});
+    const Scene one = looseTriangles({{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}});
     const BspTree t1 = buildBspTree(one);
     EXPECT_EQ(t1.stats.nodes, 1u);
     EXPECT_EQ(t1.stats.depth, 1u);
@@ -118,7 +105,7 @@ TEST(BspTree, EmptyAndSingle) {
 TEST(BspTree, VertexOnSplittingPlane) {
     const std::array<Vec3, 3> floor{Vec3{-10, -10, 0}, Vec3{10, -10, 0}, Vec3{0, 10, 0}};
     {
-        const Scene s = triangleScene({floor, {Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{0, 1, 1}}});
+        const Scene s = looseTriangles({floor, {Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{0, 1, 1}}});
         const BspTree t = buildBspTree(s);
         EXPECT_EQ(t.nodes[0].planeSource, 0u);
         EXPECT_EQ(t.stats.splits, 0u);
@@ -128,7 +115,7 @@ TEST(BspTree, VertexOnSplittingPlane) {
         EXPECT_EQ(t.nodes[0].back, -1);
     }
     {
-        const Scene s = triangleScene({floor, {Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{1, 1, -1}}});
+        const Scene s = looseTriangles({floor, {Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{1, 1, -1}}});
         const BspTree t = buildBspTree(s);
         EXPECT_EQ(t.nodes[0].planeSource, 0u);
         EXPECT_EQ(t.stats.splits, 1u);
@@ -156,7 +143,7 @@ TEST(BspTree, VertexOnSplittingPlane) {
 // Coplanar overlapping triangles stay on one node; drawn back to front they tie exactly (same
 // plane): 0 wrong pixels, every pixel both cover is a tie where the higher id was drawn last.
 TEST(BspTree, CoplanarOverlapping) {
-    const Scene s = triangleScene({{Vec3{-3, -3, 0}, Vec3{3, -3, 0}, Vec3{0, 3, 0}},
+    const Scene s = looseTriangles({{Vec3{-3, -3, 0}, Vec3{3, -3, 0}, Vec3{0, 3, 0}},
                                    {Vec3{-3, 3, 0}, Vec3{0, -3, 0}, Vec3{3, 3, 0}}});
     const BspTree t = buildBspTree(s);
     EXPECT_EQ(t.stats.nodes, 1u);
@@ -175,7 +162,7 @@ TEST(BspTree, CoplanarOverlapping) {
 
 // The cycle: no order of the three triangles is right; the BSP splits and gets every pixel right.
 TEST(BspTree, CyclicOverlapSplitsAndIsExact) {
-    const Scene s = triangleScene(cyclicSticks());
+    const Scene s = looseTriangles(cyclicSticks());
     const BspTree t = buildBspTree(s);
     EXPECT_GE(t.stats.splits, 1u);
     EXPECT_EQ(t.stats.pieces, 3 + t.stats.splits);
@@ -197,7 +184,7 @@ TEST(BspTree, CyclicOverlapSplitsAndIsExact) {
 
 // Two triangles passing through each other: the BSP cuts one along the other's plane.
 TEST(BspTree, Interpenetrating) {
-    const Scene s = triangleScene({{Vec3{-4, -3, -1}, Vec3{4, -3, -1}, Vec3{0, 3, 1}},
+    const Scene s = looseTriangles({{Vec3{-4, -3, -1}, Vec3{4, -3, -1}, Vec3{0, 3, 1}},
                                    {Vec3{-4, 3, -1}, Vec3{0, -3, 1}, Vec3{4, 3, -1}}});
     const BspTree t = buildBspTree(s);
     EXPECT_EQ(t.stats.splits, 1u);
@@ -218,7 +205,7 @@ TEST(BspTree, FarFromOriginSameClassification) {
         tris.push_back({off + Vec3{-10, -10, 0} * scale, off + Vec3{10, -10, 0} * scale, off + Vec3{0, 10, 0} * scale});
         tris.push_back({off + Vec3{0, 0, 0} * scale, off + Vec3{1, 0, 1} * scale, off + Vec3{0, 1, 1} * scale});
         tris.push_back({off + Vec3{0, 0, 0} * scale, off + Vec3{1, 0, 1} * scale, off + Vec3{1, 1, -1} * scale});
-        return triangleScene(tris);
+        return looseTriangles(tris);
     };
     const BspTree near = buildBspTree(scene(1, {}));
     const double s = std::ldexp(1.0, -10);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_util.h"
 #include "analysis/demo.h"
 #include "analysis/effects_plan.h"
 #include "analysis/load.h"
@@ -20,18 +21,7 @@
 namespace va {
 namespace {
 
-Scene looseTriangles(const std::vector<std::array<Vec3, 3>> &tris) {
-    SceneBuildInput in;
-    in.materials = {Material{}};
-    for (size_t i = 0; i < tris.size(); ++i) {
-        SceneBuildInput::Object o;
-        o.name = "t" + std::to_string(i);
-        o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
-        o.geometry.indices = {0, 1, 2};
-        in.objects.push_back(std::move(o));
-    }
-    return buildScene(std::move(in));
-}
+using testing_util::looseTriangles;
 
 // The cyclic sticks of test_bsp_tree.cpp (three thin triangles, each over the next), counter-
 // clockwise from above.

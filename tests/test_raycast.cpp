@@ -10,34 +10,14 @@
 #include <tuple>
 
 #include "analysis/demo.h"
+#include "tests/test_util.h"
 #include "analysis/scene.h"
 #include "render/raycast.h"
 
 using namespace va;
+using namespace va::testing_util;
 
 namespace {
-
-Scene sceneOf(std::vector<RawMesh> meshes, std::vector<Material> mats = {Material{}},
-              std::vector<uint32_t> matOf = {}) {
-    SceneBuildInput in;
-    in.materials = std::move(mats);
-    for (size_t i = 0; i < meshes.size(); ++i) {
-        SceneBuildInput::Object o;
-        o.name = "o" + std::to_string(i);
-        o.material = i < matOf.size() ? matOf[i] : 0;
-        o.geometry = std::move(meshes[i]);
-        in.objects.push_back(std::move(o));
-    }
-    return buildScene(std::move(in));
-}
-
-RawMesh triangleMesh(Vec3 a, Vec3 b, Vec3 c) {
-    RawMesh m;
-    m.positions = {a, b, c};
-    m.indices = {0, 1, 2};
-    m.facesRead = 1;
-    return m;
-}
 
 // Every triangle of the scene that is not excluded, in source order.
 std::vector<uint32_t> sceneTriangles(const Scene &s) {

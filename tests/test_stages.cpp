@@ -6,34 +6,14 @@
 
 #include "analysis/backface.h"
 #include "analysis/demo.h"
+#include "tests/test_util.h"
 #include "analysis/frustum.h"
 #include "analysis/pipeline.h"
 
 using namespace va;
+using namespace va::testing_util;
 
 namespace {
-
-Scene sceneOf(std::vector<RawMesh> meshes, std::vector<Material> mats = {Material{}},
-              std::vector<uint32_t> matOf = {}) {
-    SceneBuildInput in;
-    in.materials = std::move(mats);
-    for (size_t i = 0; i < meshes.size(); ++i) {
-        SceneBuildInput::Object o;
-        o.name = "o" + std::to_string(i);
-        o.material = i < matOf.size() ? matOf[i] : 0;
-        o.geometry = std::move(meshes[i]);
-        in.objects.push_back(std::move(o));
-    }
-    return buildScene(std::move(in));
-}
-
-RawMesh triangleMesh(Vec3 a, Vec3 b, Vec3 c) {
-    RawMesh m;
-    m.positions = {a, b, c};
-    m.indices = {0, 1, 2};
-    m.facesRead = 1;
-    return m;
-}
 
 ViewSpec viewOf(Vec3 eye, Vec3 target, int w = 64, int h = 48, double fov = 60, double nearZ = 0.1,
                 double farZ = 100) {

@@ -1,0 +1,51 @@
+// Small scene builders shared by the tests.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "analysis/scene.h"
+
+namespace va::testing_util {
+
+// One source object per mesh, named "o0", "o1", ...; matOf[i] picks mesh i's material (default 0).
+inline Scene sceneOf(std::vector<RawMesh> meshes, std::vector<Material> mats = {Material{}},
+                     std::vector<uint32_t> matOf = {}) {
+    SceneBuildInput in;
+    in.materials = std::move(mats);
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        SceneBuildInput::Object o;
+        o.name = "o" + std::to_string(i);
+        o.material = i < matOf.size() ? matOf[i] : 0;
+        o.geometry = std::move(meshes[i]);
+        in.objects.push_back(std::move(o));
+    }
+    return buildScene(std::move(in));
+}
+
+inline RawMesh triangleMesh(Vec3 a, Vec3 b, Vec3 c) {
+    RawMesh m;
+    m.positions = {a, b, c};
+    m.indices = {0, 1, 2};
+    m.facesRead = 1;
+    return m;
+}
+
+// Loose triangles, one object each, named "t0", "t1", ...; one material.
+inline Scene looseTriangles(const std::vector<std::array<Vec3, 3>> &tris, bool doubleSided = false) {
+    SceneBuildInput in;
+    Material m;
+    m.doubleSided = doubleSided;
+    in.materials = {m};
+    for (size_t i = 0; i < tris.size(); ++i) {
+        SceneBuildInput::Object o;
+        o.name = "t" + std::to_string(i);
+        o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
+        o.geometry.indices = {0, 1, 2};
+        in.objects.push_back(std::move(o));
+    }
+    return buildScene(std::move(in));
+}
+
+}  // namespace va::testing_util
