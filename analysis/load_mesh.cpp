@@ -150,37 +150,37 @@ private:
 };
 
 // OpenMesh's readers are driven through a process-wide IOManager and log to the global streams
-// omerr/omlog/omout. One mutex serializes reads; while it is held the three streams are re-routed
-// from the console into a string, which becomes part of our message when the read fails.
+// omerr/omlog/omout. One mutex serializes reads; while it is held the three streams write into a
+// string instead of the console, which becomes part of our message when the read fails.
+// The streams' buffers are swapped (std::ostream::rdbuf), not re-targeted with OpenMesh's
+// connect/disconnect: disconnect drops its target without deleting it, 16 bytes lost per stream
+// and read (found by fuzz_obj's leak check; tests/test_fuzz_regressions.cpp).
 std::mutex gOpenMeshMutex;
 
 class CaptureOpenMeshLog {
 public:
     CaptureOpenMeshLog() {
-        for (auto *s : {&omerr(), &omlog(), &omout()}) {
-            s->flush();
-            s->disconnect(std::cerr);
-            s->disconnect(std::clog);
-            s->disconnect(std::cout);
-            s->connect(buf_);
+        for (int i = 0; i < 3; ++i) {
+            streams_[i]->flush();
+            saved_[i] = streams_[i]->rdbuf(buf_.rdbuf());
         }
     }
     ~CaptureOpenMeshLog() {
-        omerr().flush(), omlog().flush(), omout().flush();
-        omerr().disconnect(buf_), omlog().disconnect(buf_), omout().disconnect(buf_);
-        // OpenMesh's defaults: omerr -> cerr, omlog -> clog, omout -> cout.
-        omerr().connect(std::cerr);
-        omlog().connect(std::clog);
-        omout().connect(std::cout);
+        for (int i = 0; i < 3; ++i) {
+            streams_[i]->flush();
+            streams_[i]->rdbuf(saved_[i]);
+        }
     }
     std::string text() {
-        omerr().flush(), omlog().flush(), omout().flush();
+        for (auto *s : streams_) s->flush();
         std::string t = buf_.str();
         while (!t.empty() && std::isspace((unsigned char)t.back())) t.pop_back();
         return t;
     }
 
 private:
+    std::ostream *streams_[3] = {&omerr(), &omlog(), &omout()};
+    std::streambuf *saved_[3] = {};
     std::ostringstream buf_;
 };
 
@@ -337,6 +337,289 @@ bool checkOff(const std::string &path, const std::string &text, size_t positions
     return true;
 }
 
+// ---- Structure checks before OpenMesh's readers see a file ----------------------------------------
+// OpenMesh's readers trust the file: an OBJ face corner without a vertex index fails an assert
+// (abort), and an OFF or PLY count (vertices, faces, a face's corners, a list's length) larger than
+// the file drives a read loop on a failed stream for up to 2^32 iterations (a hang). The checks below
+// walk the file's structure first, bounding every count by the bytes that are there; found by
+// fuzz_obj, fuzz_off and fuzz_ply (tests/test_fuzz_regressions.cpp).
+
+std::string clip(std::string_view l) {
+    std::string s(l.substr(0, 80));
+    for (auto &c : s)
+        if (!std::isprint((unsigned char)c)) c = '?';
+    return l.size() > 80 ? s + "..." : s;
+}
+
+// No corner of an "f" line starts with '/' ("/vt", "//vn": no vertex index), which fails OpenMesh's
+// assert. Other malformed corners ("a") become invalid indices that the reader reports and drops.
+bool preCheckObj(const std::string &path, const std::string &text, std::string *err) {
+    std::string msg;
+    forEachLine(text, [&](size_t n, std::string_view l) {
+        if (firstWord(l) != "f") return true;
+        size_t i = l.find('f') + 1;
+        while (i < l.size()) {
+            i = l.find_first_not_of(" \t", i);
+            if (i == std::string_view::npos) break;
+            const size_t e = std::min(l.size(), l.find_first_of(" \t", i));
+            const std::string_view tok = l.substr(i, e - i);
+            if (tok[0] == '/') {
+                msg = path + ":" + std::to_string(n) + ": face '" + clip(l) + "': corner '" + clip(tok) +
+                      "' has no vertex index; write corners as v, v/vt, v//vn or v/vt/vn with integer indices";
+                return false;
+            }
+            i = e;
+        }
+        return true;
+    });
+    if (msg.empty()) return true;
+    *err = msg;
+    return false;
+}
+
+std::vector<std::string_view> words(std::string_view l) {
+    std::vector<std::string_view> w;
+    size_t i = 0;
+    while ((i = l.find_first_not_of(" \t\r\f\v", i)) != std::string_view::npos) {
+        const size_t e = std::min(l.size(), l.find_first_of(" \t\r\f\v", i));
+        w.push_back(l.substr(i, e - i));
+        i = e;
+    }
+    return w;
+}
+
+bool parseCount(std::string_view w, uint64_t *out) {
+    if (w.empty() || w.size() > 19) return false;
+    uint64_t v = 0;
+    for (char c : w) {
+        if (!std::isdigit((unsigned char)c)) return false;
+        v = v * 10 + uint64_t(c - '0');
+    }
+    *out = v;
+    return true;
+}
+
+// ASCII OFF: one vertex per line, then one face per line "N i1 .. iN [color]". Blank and '#' lines
+// are skipped here (checkOff reports the '#' lines OpenMesh misreads). Binary OFF is refused: its
+// counts would have to be trusted.
+bool preCheckOff(const std::string &path, const std::string &text, std::string *err) {
+    // Text only: OpenMesh's stream extraction and our line split then agree on what a word is.
+    const auto bad = std::find_if(text.begin(), text.end(), [](char ch) {
+        const unsigned char c = (unsigned char)ch;
+        return !((c >= 0x20 && c < 0x7f) || c == '\t' || c == '\n' || c == '\r');
+    });
+    if (bad != text.end()) {
+        const size_t line = 1 + size_t(std::count(text.begin(), bad, '\n'));
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02x", unsigned((unsigned char)*bad));
+        *err = path + ":" + std::to_string(line) + ": byte " + hex + " is not text; visaudit reads ascii OFF "
+               "(binary OFF is not supported: its counts cannot be checked before OpenMesh's reader trusts "
+               "them); convert the mesh to ascii OFF or PLY";
+        return false;
+    }
+    enum { kHeader, kCounts, kVertices, kFaces, kDone } state = kHeader;
+    uint64_t nv = 0, nf = 0, ne = 0, seen = 0;
+    bool plain = false;  // "OFF": exactly 3 coordinates per vertex line
+    std::string msg;
+    forEachLine(text, [&](size_t n, std::string_view l) {
+        const std::string_view w = firstWord(l);
+        if (w.empty() || w[0] == '#') return true;
+        const std::string at = path + ":" + std::to_string(n) + ": ";
+        if (state == kHeader) {
+            state = kCounts;
+            if (w.size() >= 3 && w.substr(w.size() - 3) == "OFF") {
+                plain = w == "OFF";
+                if (l.find("BINARY") != std::string_view::npos) {
+                    msg = at + "binary OFF is not supported (its counts cannot be checked before OpenMesh's "
+                               "reader trusts them); convert the mesh to ascii OFF or PLY";
+                    return false;
+                }
+                return true;
+            }
+            msg = at + "expected the OFF keyword (OFF, COFF, NOFF, ...) as the first word, got '" + clip(l) + "'";
+            return false;
+        }
+        if (state == kCounts) {
+            const auto c = words(l);
+            if (c.size() < 3 || !parseCount(c[0], &nv) || !parseCount(c[1], &nf) || !parseCount(c[2], &ne)) {
+                msg = at + "expected the OFF counts line 'VERTICES FACES EDGES' (three integers; OpenMesh's reader "
+                           "needs the edge count, 0 is fine), got '" + clip(l) + "'";
+                return false;
+            }
+            state = nv > 0 ? kVertices : nf > 0 ? kFaces : kDone;
+            return state != kDone;
+        }
+        ++seen;
+        if (state == kVertices) {
+            const size_t nw = words(l).size();
+            if (plain ? nw != 3 : nw < 3) {
+                msg = at + "vertex " + std::to_string(seen - 1) + " '" + clip(l) + "': expected " +
+                      (plain ? "exactly " : "") + "3 coordinates on the line";
+                return false;
+            }
+            if (seen == nv) state = nf > 0 ? kFaces : kDone, seen = 0;
+            return state != kDone;
+        }
+        const auto f = words(l);
+        // N, N indices below the vertex count, then at most a color (up to 4 numbers 0..255): every
+        // word stays small, so no misread can become a huge corner count.
+        uint64_t corners = 0, index = 0;
+        bool ok = parseCount(f[0], &corners) && corners + 1 <= f.size() && f.size() <= corners + 5;
+        for (uint64_t k = 1; ok && k <= corners; ++k) ok = parseCount(f[k], &index) && index < nv;
+        for (size_t k = size_t(corners) + 1; ok && k < f.size(); ++k) {
+            const std::string t(f[k]);
+            char *end = nullptr;
+            const double c = std::strtod(t.c_str(), &end);
+            ok = end == t.c_str() + t.size() && c >= 0 && c <= 255;
+        }
+        if (!ok) {
+            msg = at + "face " + std::to_string(seen - 1) + " '" + clip(l) + "': expected the number of corners N, then N vertex "
+                       "indices below " + std::to_string(nv) + " and at most a color on the line; fix the face (or the counts line)";
+            return false;
+        }
+        if (seen == nf) state = kDone;
+        return state != kDone;
+    });
+    if (!msg.empty()) {
+        *err = msg;
+        return false;
+    }
+    if (state == kHeader || state == kCounts) {
+        *err = path + ": no " + std::string(state == kHeader ? "OFF keyword and no " : "") +
+               "counts line 'VERTICES FACES EDGES'; the file is truncated or not an OFF file";
+        return false;
+    }
+    if (state == kVertices || state == kFaces) {
+        *err = path + ": the counts line declares " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+               " faces but the file ends after " + std::string(state == kVertices ? "vertex " : "face ") +
+               std::to_string(seen) + "; the file is truncated, or fix the counts";
+        return false;
+    }
+    return true;
+}
+
+// PLY: the header's elements and properties, then every row of the body (ascii tokens or binary
+// bytes), each list length checked against what is left of the file.
+bool preCheckPly(const std::string &path, const std::string &text, std::string *err) {
+    struct Property {
+        int countBytes = 0;  // a list's length type; 0 for a scalar
+        int bytes = 0;       // the (item) type's size
+    };
+    struct Element {
+        std::string name;
+        uint64_t rows = 0;
+        std::vector<Property> props;
+    };
+    auto typeBytes = [](std::string_view t) {
+        if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+        if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+        if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+        if (t == "double" || t == "float64") return 8;
+        return 0;
+    };
+    std::vector<Element> elements;
+    std::string format, msg;
+    size_t body = std::string::npos;
+    size_t b = 0, line = 0;
+    while (b < text.size() && body == std::string::npos) {
+        size_t e = text.find('\n', b);
+        if (e == std::string::npos) e = text.size();
+        const std::string_view l = std::string_view(text).substr(b, e - b);
+        const auto w = words(l);
+        ++line;
+        const std::string at = path + ":" + std::to_string(line) + ": ";
+        // Header lines are text: OpenMesh's header parser and this one then split words alike.
+        for (char ch : l)
+            if (!((unsigned char)ch >= 0x20 && (unsigned char)ch < 0x7f) && ch != '\t' && ch != '\r')
+                return *err = at + "the PLY header holds a byte that is not text; is the header truncated?", false;
+        if (line == 1) {
+            if (w.size() != 1 || w[0] != "ply") return *err = path + ":1: expected 'ply', got '" + clip(l) + "'", false;
+        } else if (w.empty() || w[0] == "comment" || w[0] == "obj_info") {
+        } else if (w[0] == "end_header") {
+            body = e + 1;
+        } else if (w[0] == "format" && w.size() == 3 && format.empty() && w[2] == "1.0" &&
+                   (w[1] == "ascii" || w[1] == "binary_little_endian" || w[1] == "binary_big_endian")) {
+            format = std::string(w[1]);
+        } else if (w[0] == "element" && w.size() == 3 && parseCount(w[2], &elements.emplace_back().rows)) {
+            elements.back().name = std::string(w[1]);
+        } else if (w[0] == "property" && !elements.empty() && w.size() == 3 && typeBytes(w[1])) {
+            elements.back().props.push_back({0, typeBytes(w[1])});
+        } else if (w[0] == "property" && !elements.empty() && w.size() == 5 && w[1] == "list" &&
+                   typeBytes(w[2]) && typeBytes(w[3]) && w[2] != "float" && w[2] != "float32" && w[2] != "double" &&
+                   w[2] != "float64") {
+            elements.back().props.push_back({typeBytes(w[2]), typeBytes(w[3])});
+        } else {
+            return *err = at + "unexpected header line '" + clip(l) + "'; expected format, element, property " +
+                          "(types char uchar short ushort int uint float double, or int8..float64), comment or end_header",
+                   false;
+        }
+        b = e + 1;
+    }
+    if (body == std::string::npos) return *err = path + ": the PLY header has no 'end_header' line", false;
+    if (format.empty()) return *err = path + ": the PLY header has no 'format' line; add 'format ascii 1.0' (or binary_little_endian 1.0)", false;
+    for (const auto &el : elements)
+        if (el.rows > 0 && el.props.empty())
+            return *err = path + ": element '" + el.name + "' declares " + std::to_string(el.rows) +
+                          " rows but no properties; fix the header", false;
+
+    size_t pos = body;
+    const bool ascii = format == "ascii", big = format == "binary_big_endian";
+    // One value of the body: an ascii token, or `bytes` bytes (returned as an unsigned number).
+    auto next = [&](int bytes, uint64_t *value) {
+        if (ascii) {
+            pos = text.find_first_not_of(" \t\r\n\f\v", pos);
+            if (pos == std::string::npos) return pos = text.size(), false;
+            const size_t e = std::min(text.size(), text.find_first_of(" \t\r\n\f\v", pos));
+            const std::string_view tok = std::string_view(text).substr(pos, e - pos);
+            pos = e;
+            if (value) {
+                // A list length: a whole number; anything else is refused below.
+                char *end = nullptr;
+                const std::string t(tok);
+                const double x = std::strtod(t.c_str(), &end);
+                if (end != t.c_str() + t.size() || !(x >= 0) || x != std::floor(x) || x > 4294967295.0) return false;
+                *value = uint64_t(x);
+            }
+            return true;
+        }
+        if (text.size() - pos < size_t(bytes)) return false;
+        if (value) {
+            uint64_t v = 0;
+            for (int k = 0; k < bytes; ++k)
+                v |= uint64_t((unsigned char)text[pos + (big ? size_t(bytes - 1 - k) : size_t(k))]) << (8 * k);
+            // Signed length types: a negative length is as wrong as a huge one.
+            *value = v;
+        }
+        pos += size_t(bytes);
+        return true;
+    };
+    for (const auto &el : elements) {
+        for (uint64_t r = 0; r < el.rows; ++r) {
+            for (const auto &pr : el.props) {
+                const std::string place = path + ": element '" + el.name + "' row " + std::to_string(r) + ": ";
+                if (pr.countBytes == 0) {
+                    if (!next(pr.bytes, nullptr))
+                        return *err = place + "the file ends early (the header declares " + std::to_string(el.rows) +
+                                      " rows); the file is truncated, or fix the element's count", false;
+                    continue;
+                }
+                uint64_t n = 0;
+                if (!next(pr.countBytes, &n))
+                    return *err = place + "expected a list length; the file is truncated or the row is malformed", false;
+                // Every item takes at least one byte (a token and its separator, or its binary size).
+                const uint64_t left = text.size() - pos;
+                if (n > left / uint64_t(ascii ? 1 : pr.bytes))
+                    return *err = place + "a list of " + std::to_string(n) + " items, more than the " + std::to_string(left) +
+                                  " bytes left in the file; the row is malformed", false;
+                for (uint64_t k = 0; k < n; ++k)
+                    if (!next(pr.bytes, nullptr))
+                        return *err = place + "the file ends inside a list of " + std::to_string(n) + " items", false;
+            }
+        }
+    }
+    return true;
+}
+
 }  // namespace
 
 bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
@@ -354,6 +637,14 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
         std::ifstream probe(path, std::ios::binary);
         if (!probe) return fail(path + ": cannot open the file for reading (check its permissions)");
         if (probe.peek() == std::ifstream::traits_type::eof()) return fail(path + ": the file is empty");
+    }
+
+    std::string text;
+    if (ext != ".stl") {
+        if (!readAll(path, &text)) return fail(path + ": cannot read the file");
+        if (ext == ".obj" && !preCheckObj(path, text, err)) return false;
+        if (ext == ".ply" && !preCheckPly(path, text, err)) return false;
+        if (ext == ".off" && !preCheckOff(path, text, err)) return false;
     }
 
     RawMesh m;
@@ -391,8 +682,6 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
         uint64_t n = 0;
         if (countStlFacets(path, &n) && n > m.facesRead) inFile = n;
     } else if (ext == ".obj" || ext == ".off") {
-        std::string text;
-        if (!readAll(path, &text)) return fail(path + ": cannot read the file");
         if (ext == ".obj") {
             uint64_t faceLines = 0;
             if (!checkObj(path, text, m.positions.size(), &faceLines, err)) return false;

@@ -10,6 +10,7 @@ PACKAGES=(
   libtinygltf-dev libstb-dev libzip-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   parallel
+  clang-14 libclang-rt-14-dev llvm-14
   chromium fonts-dejavu-core nodejs
 )
 

@@ -1,0 +1,3 @@
+// OFF files: see fuzz_mesh.h.
+#define VISAUDIT_FUZZ_EXT ".off"
+#include "fuzz/fuzz_mesh.h"

@@ -1,0 +1,3 @@
+// STL files: see fuzz_mesh.h.
+#define VISAUDIT_FUZZ_EXT ".stl"
+#include "fuzz/fuzz_mesh.h"
