@@ -1,11 +1,13 @@
-// Single-thread z-buffer throughput on the benchmark scene (analysis/bench_scene.h).
+// z-buffer throughput on the benchmark scene (analysis/bench_scene.h), one thread and all threads.
 //
-//   bench_zbuffer [--reps N] [--format NAME]
+//   bench_zbuffer [--reps N] [--format NAME] [--tile-shift S]
 //
 // Builds the 1,000,002-triangle sphere grid, clips and projects it once with the clip stage
 // (va::clipTriangles), then times va::rasterize() alone -- buffer allocation and clearing included,
-// since they are part of every call -- over N repetitions on the calling thread, and reports the
-// best and the median.
+// since they are part of every call -- over N repetitions per configuration (the plain walk, the
+// default strategy and the tiled kernels on one thread; the default on all threads), and reports
+// the best and the median, M triangles/s and M fragments/s (from the best wall time), and whether
+// every configuration produced the same stats (the exit status is 1 if not).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,7 +15,10 @@
 #include <cstring>
 #include <string>
 #include <ctime>
+#include <thread>
 #include <vector>
+
+#include <tbb/global_control.h>
 
 #include "analysis/bench_scene.h"
 #include "render/clip.h"
@@ -21,6 +26,7 @@
 
 int main(int argc, char **argv) {
     int reps = 9;
+    int tileShift = 0;
     va::DepthFormat format = va::DepthFormat::f32;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) {
@@ -31,8 +37,10 @@ int main(int argc, char **argv) {
                 std::fprintf(stderr, "bench_zbuffer: %s\n", err.c_str());
                 return 2;
             }
+        } else if (!std::strcmp(argv[i], "--tile-shift") && i + 1 < argc) {
+            tileShift = std::atoi(argv[++i]);
         } else {
-            std::fprintf(stderr, "usage: bench_zbuffer [--reps N] [--format NAME]\n");
+            std::fprintf(stderr, "usage: bench_zbuffer [--reps N] [--format NAME] [--tile-shift S]\n");
             return 2;
         }
     }
@@ -67,57 +75,83 @@ int main(int argc, char **argv) {
     settings.encoder = va::makeDepthEncoder(format, cam.nearZ, cam.farZ);
     settings.orthographic = cam.orthographic;
 
-    // Wall time, and the thread's CPU time (CLOCK_THREAD_CPUTIME_ID): on a shared machine the
-    // latter excludes the time the thread waited for a core, the former is what a user sees.
+    // Wall time, and the process's CPU time: on a shared machine CPU time excludes the time the
+    // threads waited for a core (with one thread it is the thread's own time), wall time is what a
+    // user sees. Each configuration runs under its own tbb::global_control, as the CLI's --threads.
     auto cpuNow = [] {
         timespec ts;
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
         return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
     };
-    std::vector<double> seconds, cpuSeconds;
-    va::ZBufferStats stats;
-    for (int r = 0; r < reps; ++r) {
-        const double c0cpu = cpuNow();
-        const auto t0 = std::chrono::steady_clock::now();
-        va::ZBufferResult res = va::rasterize(tris, cam.width, cam.height, settings);
-        const auto t1 = std::chrono::steady_clock::now();
-        cpuSeconds.push_back(cpuNow() - c0cpu);
-        seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
-        stats = std::move(res.stats);
-    }
-    std::sort(cpuSeconds.begin(), cpuSeconds.end());
-    // The fixed cost of a call: allocating and clearing the five per-pixel buffers, and the
-    // histogram pass of finishZBufferStats, measured on an empty triangle list.
-    std::vector<double> overhead;
-    for (int r = 0; r < reps; ++r) {
-        const auto t0 = std::chrono::steady_clock::now();
-        va::ZBufferResult res = va::rasterize(va::ScreenTriangles{}, cam.width, cam.height, settings);
-        const auto t1 = std::chrono::steady_clock::now();
-        overhead.push_back(std::chrono::duration<double>(t1 - t0).count());
-    }
-    std::sort(overhead.begin(), overhead.end());
-    std::vector<double> sorted = seconds;
-    std::sort(sorted.begin(), sorted.end());
-    const double best = sorted.front(), median = sorted[sorted.size() / 2];
-    const double n = double(tris.size());
+    struct Timing {
+        double best = 0, median = 0, cpuBest = 0;
+        va::ZBufferStats stats;
+    };
+    auto run = [&](const va::ScreenTriangles &input, int threads, const va::RasterStrategy &strategy) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        std::vector<double> seconds, cpuSeconds;
+        Timing timing;
+        for (int r = 0; r < reps; ++r) {
+            const double c0cpu = cpuNow();
+            const auto t0 = std::chrono::steady_clock::now();
+            va::ZBufferResult res = va::rasterize(input, cam.width, cam.height, settings, strategy);
+            const auto t1 = std::chrono::steady_clock::now();
+            cpuSeconds.push_back(cpuNow() - c0cpu);
+            seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+            timing.stats = std::move(res.stats);
+        }
+        std::sort(seconds.begin(), seconds.end());
+        std::sort(cpuSeconds.begin(), cpuSeconds.end());
+        timing.best = seconds.front();
+        timing.median = seconds[seconds.size() / 2];
+        timing.cpuBest = cpuSeconds.front();
+        return timing;
+    };
 
+    const int allThreads = std::max(1, int(std::thread::hardware_concurrency()));
+    const double n = double(tris.size());
     std::printf("scene: %u triangles, %zu screen triangles after clipping (clip %.1f ms)\n", triCount,
                 tris.size(), 1e3 * std::chrono::duration<double>(c1 - c0).count());
-    std::printf("view: %dx%d, format %s, %d repetitions\n", cam.width, cam.height,
-                va::depthFormatInfo(format).name, reps);
-    std::printf("rasterize: best %.2f ms, median %.2f ms\n", 1e3 * best, 1e3 * median);
-    std::printf("rasterize thread CPU time: best %.2f ms, median %.2f ms (%.2f M triangles/s)\n",
-                1e3 * cpuSeconds.front(), 1e3 * cpuSeconds[cpuSeconds.size() / 2], n / cpuSeconds.front() * 1e-6);
-    std::printf("of which buffers and stats (empty input): best %.2f ms\n", 1e3 * overhead.front());
-    std::printf("triangles drawn %llu, empty %llu; fragments %llu, depth passes %llu\n",
-                (unsigned long long)stats.trianglesDrawn, (unsigned long long)stats.trianglesEmpty,
-                (unsigned long long)stats.fragments, (unsigned long long)stats.depthPasses);
+    std::printf("view: %dx%d, format %s, %d repetitions, %d hardware threads\n", cam.width, cam.height,
+                va::depthFormatInfo(format).name, reps, allThreads);
+    const Timing empty = run(va::ScreenTriangles{}, 1, {});
+    std::printf("fixed cost of a call (buffers and stats, empty input, one thread): best %.2f ms\n\n", 1e3 * empty.best);
+
+    struct Config {
+        const char *name;
+        int threads;
+        va::RasterStrategy strategy;
+    };
+    using Path = va::RasterStrategy::Path;
+    std::vector<Config> configs = {
+        {"plain walk (reference)", 1, {Path::plainWalk, true, 0}},
+        {"default", 1, {}},
+        {"tiled, baseline SSE2", 1, {Path::tiled, false, 0}},
+        {"tiled, AVX2 if present", 1, {Path::tiled, true, 0}},
+        {"default", allThreads, {}},
+    };
+    if (tileShift > 0)
+        for (Config &c : configs) c.strategy.tileShift = tileShift;
+    std::printf("%-24s %7s %10s %10s %10s %12s %12s\n", "rasterize", "threads", "best ms", "median ms", "CPU ms",
+                "M tri/s", "M frag/s");
+    va::ZBufferStats reference;
+    bool identical = true;
+    for (size_t i = 0; i < configs.size(); ++i) {
+        const Config &c = configs[i];
+        const Timing t = run(tris, c.threads, c.strategy);
+        std::printf("%-24s %7d %10.2f %10.2f %10.2f %12.2f %12.1f\n", c.name, c.threads, 1e3 * t.best,
+                    1e3 * t.median, 1e3 * t.cpuBest, n / t.best * 1e-6, double(t.stats.fragments) / t.best * 1e-6);
+        if (i == 0) reference = t.stats;
+        identical = identical && t.stats.fragments == reference.fragments &&
+                    t.stats.depthPasses == reference.depthPasses && t.stats.histogram == reference.histogram &&
+                    t.stats.trianglesDrawn == reference.trianglesDrawn;
+    }
+    std::printf("\ntriangles drawn %llu, empty %llu; fragments %llu, depth passes %llu\n",
+                (unsigned long long)reference.trianglesDrawn, (unsigned long long)reference.trianglesEmpty,
+                (unsigned long long)reference.fragments, (unsigned long long)reference.depthPasses);
     std::printf("covered pixels %llu, overdraw %.4f, depth complexity %.4f, max %u\n",
-                (unsigned long long)stats.coveredPixels, stats.overdraw, stats.depthComplexity,
-                stats.maxDepthComplexity);
-    std::printf("fragments/s: best %.1f M, median %.1f M\n", double(stats.fragments) / best * 1e-6,
-                double(stats.fragments) / median * 1e-6);
-    std::printf("triangles/s: best %.2f M, median %.2f M\n", n / best * 1e-6, n / median * 1e-6);
-    std::printf("zbuffer: %.2f M triangles/s (one thread)\n", n / best * 1e-6);
-    return 0;
+                (unsigned long long)reference.coveredPixels, reference.overdraw, reference.depthComplexity,
+                reference.maxDepthComplexity);
+    std::printf("stats identical across configurations: %s\n", identical ? "yes" : "NO");
+    return identical ? 0 : 1;
 }

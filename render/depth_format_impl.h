@@ -19,14 +19,11 @@ inline uint32_t floatBits(float v) {
 
 // Clamps d into [lo, hi]; sets oor when it had to. d == lo returns lo itself, so d = -0.0 with
 // lo = 0 encodes as +0.0 (a float key of -0.0 would sort after every positive depth). A NaN depth
-// is out of range and clamped to the far end (never reaches an integer conversion).
+// is out of range and clamped to the far end (never reaches an integer conversion). Written without
+// branches (selects), so the rasterizer's batch loops over it vectorize (raster_kernel.h).
 inline double clampDepth(double d, double lo, double hi, bool &oor) {
-    if (d <= lo) {
-        if (d < lo) oor = true;
-        return lo;
-    }
-    if (!(d <= hi)) { oor = true; return hi; }
-    return d;
+    oor = oor | (d < lo) | !(d <= hi);
+    return d <= lo ? lo : (d <= hi ? d : hi);
 }
 
 // Returns the stored value (as double) and writes the ordering key.

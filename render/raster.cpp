@@ -13,8 +13,13 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include "render/depth_format_impl.h"
 #include "render/raster_core.h"
+#include "render/raster_kernel.h"
 
 namespace va {
 
@@ -107,9 +112,168 @@ void rasterizeWith(const ScreenTriangles &tris, const ZBufferSettings &settings,
     }
 }
 
+// ---- The tiled path (docs/rasterizer.md: Tiles) ----
+using namespace raster_detail;
+
+// One binning chunk: a run of consecutive triangles and what it put into each tile.
+struct BinChunk {
+    std::vector<std::vector<BinEntry>> tiles;  // per tile, in submission order
+    std::vector<uint32_t> multiCounts;         // per multi-tile triangle: fragments over all tiles
+    uint64_t backWinding = 0;
+};
+
+struct TileGrid {
+    int shift;
+    int64_t cols, rows, width, height;
+    size_t count() const { return size_t(cols * rows); }
+};
+
+// Setup and binning of triangles [t0, t1): the walk's steps 1-2 (box of centers, range, area,
+// depth plane, single-sided winding) once per triangle, then the triangle goes to every tile its
+// box of centers meets. A triangle spanning several tiles is tested against each tile's part of its
+// box: when one edge has all four corner centers of that part outside, the tile is skipped
+// (whole-tile reject); when all three edges have all four inside, the tile is marked full (whole-
+// tile accept: the kernel emits every center without edge tests). Both are exact: E + bias is
+// affine in (x, y), so over a rectangle of centers its minimum and maximum are at corners.
+void binChunk(const ScreenTriangles &tris, size_t t0, size_t t1, const TileGrid &g, const uint8_t *singleSided,
+              BinChunk &chunk) {
+    chunk.tiles.assign(g.count(), {});
+    const int32_t *const xy = tris.xy.data();
+    for (size_t t = t0; t < t1; ++t) {
+        const int32_t *v = xy + 6 * t;
+        int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
+        const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
+        const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
+        const int64_t bx0 = std::max<int64_t>(firstCenter(minX), 0), bx1 = std::min<int64_t>(lastCenter(maxX), g.width - 1);
+        const int64_t by0 = std::max<int64_t>(firstCenter(minY), 0), by1 = std::min<int64_t>(lastCenter(maxY), g.height - 1);
+        if (bx0 > bx1 || by0 > by1) continue;
+        if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed) continue;
+        const int64_t area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
+        if (area == 0) continue;
+        if (!tris.planes[tris.plane[t]].valid) continue;
+        if (singleSided && singleSided[tris.source[t]] && !(area < 0)) {
+            ++chunk.backWinding;
+            continue;
+        }
+        const int64_t tx0 = bx0 >> g.shift, tx1 = bx1 >> g.shift, ty0 = by0 >> g.shift, ty1 = by1 >> g.shift;
+        if (tx0 == tx1 && ty0 == ty1) {
+            chunk.tiles[size_t(ty0 * g.cols + tx0)].push_back({uint32_t(t), 0, 0});
+            continue;
+        }
+        if (area < 0) {
+            std::swap(x1, x2);
+            std::swap(y1, y2);
+        }
+        const uint32_t multi = uint32_t(chunk.multiCounts.size());
+        chunk.multiCounts.push_back(0);
+        for (int64_t ty = ty0; ty <= ty1; ++ty)
+            for (int64_t tx = tx0; tx <= tx1; ++tx) {
+                const int64_t cx0 = std::max(bx0, tx << g.shift), cx1 = std::min(bx1, ((tx + 1) << g.shift) - 1);
+                const int64_t cy0 = std::max(by0, ty << g.shift), cy1 = std::min(by1, ((ty + 1) << g.shift) - 1);
+                const int64_t sx = cx0 * kSubpixelOne + kHalf, sy = cy0 * kSubpixelOne + kHalf;
+                const EdgeSetup edges[3] = {setupEdge(x1, y1, x2, y2, sx, sy), setupEdge(x2, y2, x0, y0, sx, sy),
+                                            setupEdge(x0, y0, x1, y1, sx, sy)};
+                bool outside = false, inside = true;
+                for (const EdgeSetup &e : edges) {
+                    const int64_t right = e.stepX * (cx1 - cx0), down = e.stepY * (cy1 - cy0);
+                    const int64_t lo = e.value + std::min<int64_t>(right, 0) + std::min<int64_t>(down, 0);
+                    const int64_t hi = e.value + std::max<int64_t>(right, 0) + std::max<int64_t>(down, 0);
+                    outside |= hi < 0;
+                    inside &= lo >= 0;
+                }
+                if (outside) continue;
+                chunk.tiles[size_t(ty * g.cols + tx)].push_back({uint32_t(t), multi, kMultiTile | (inside ? kFullTile : 0u)});
+            }
+    }
+}
+
+// The threads rasterize() may use: the arena's concurrency within the global_control limit.
+int availableThreads() {
+    const size_t global = tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+    return int(std::max<size_t>(1, std::min<size_t>(global, size_t(tbb::this_task_arena::max_concurrency()))));
+}
+
+void rasterizeTiled(const ScreenTriangles &tris, const ZBufferSettings &settings, const RasterStrategy &strategy,
+                    int threads, ZBuffer &zb, ZBufferStats &st) {
+    TileGrid g;
+    g.shift = strategy.tileShift > 0 ? std::clamp(strategy.tileShift, 3, 16) : kDefaultTileShift;
+    g.width = zb.width;
+    g.height = zb.height;
+    g.cols = (g.width + (int64_t(1) << g.shift) - 1) >> g.shift;
+    g.rows = (g.height + (int64_t(1) << g.shift) - 1) >> g.shift;
+
+    // Binning in chunks of consecutive triangles (in parallel; each chunk keeps submission order).
+    const size_t n = tris.size();
+    constexpr size_t kChunk = size_t(1) << 14;
+    const size_t chunkCount = threads > 1 ? std::max<size_t>(1, (n + kChunk - 1) / kChunk) : 1;
+    std::vector<BinChunk> chunks(chunkCount);
+    auto bin = [&](size_t c) {
+        binChunk(tris, n * c / chunkCount, n * (c + 1) / chunkCount, g, settings.singleSided, chunks[c]);
+    };
+    if (chunkCount > 1) tbb::parallel_for(size_t(0), chunkCount, bin);
+    else bin(0);
+
+    // Per tile, its lists from every chunk in chunk order.
+    std::vector<BinList> lists(g.count() * chunkCount);
+    for (size_t tile = 0; tile < g.count(); ++tile)
+        for (size_t c = 0; c < chunkCount; ++c)
+            lists[tile * chunkCount + c] = {chunks[c].tiles[tile].data(), chunks[c].tiles[tile].size(),
+                                            chunks[c].multiCounts.data()};
+
+    const bool perspective = !settings.orthographic;
+    ShadeFn shade = nullptr;
+#if defined(__x86_64__) || defined(__i386__)
+    if (strategy.allowAvx2 && __builtin_cpu_supports("avx2"))
+        shade = shadeFunctionAvx2(settings.encoder.format, perspective, settings.exactDepth);
+#endif
+    if (!shade) shade = shadeFunctionBase(settings.encoder.format, perspective, settings.exactDepth);
+    const ShadeTarget target{tris.xy.data(),  tris.source.data(), tris.plane.data(), tris.planes.data(),
+                             &settings.encoder, settings.fragmentsPerSource, threads > 1, size_t(g.width),
+                             zb.key.data(),   zb.id.data(),       zb.depth.data(),   zb.fragments.data(),
+                             zb.passes.data()};
+    std::vector<TileCounts> counts(g.count());
+    auto shadeOne = [&](size_t tile) {
+        const int64_t tx = int64_t(tile) % g.cols, ty = int64_t(tile) / g.cols;
+        const TileWork work{tx << g.shift, std::min(((tx + 1) << g.shift) - 1, g.width - 1), ty << g.shift,
+                            std::min(((ty + 1) << g.shift) - 1, g.height - 1), &lists[tile * chunkCount], chunkCount};
+        shade(target, work, counts[tile]);
+    };
+    if (threads > 1) tbb::parallel_for(size_t(0), g.count(), shadeOne);
+    else for (size_t tile = 0; tile < g.count(); ++tile) shadeOne(tile);
+
+    // Integer sums: the same in any order, so the same for any thread count.
+    uint64_t drawn = 0;
+    for (const TileCounts &c : counts) {
+        st.fragments += c.fragments;
+        st.depthPasses += c.passes;
+        st.outOfRangeFragments += c.outOfRange;
+        drawn += c.drawnSingle;
+    }
+    for (const BinChunk &c : chunks) {
+        for (uint32_t m : c.multiCounts) drawn += m != 0 ? 1 : 0;
+        st.trianglesBackWinding += c.backWinding;
+    }
+    st.trianglesDrawn += drawn;
+    st.trianglesEmpty += st.trianglesIn - drawn;
+    if (settings.exactDepth)
+        for (size_t i = 0; i < zb.id.size(); ++i)
+            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
+}
+
 }  // namespace
 
+namespace raster_detail {
+ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth) {
+    return selectShade(format, perspective, exactDepth);
+}
+}  // namespace raster_detail
+
 ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings) {
+    return rasterize(tris, width, height, settings, RasterStrategy{});
+}
+
+ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings,
+                        const RasterStrategy &strategy) {
     ZBufferResult r;
     ZBuffer &zb = r.buffer;
     zb.width = std::max(width, 0);
@@ -123,7 +287,12 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
 
     ZBufferStats &st = r.stats;
     st.trianglesIn = tris.size();
-    if (pixels > 0) {
+    const int threads = availableThreads();
+    const bool tiled = strategy.path == RasterStrategy::Path::tiled ||
+                       (strategy.path == RasterStrategy::Path::automatic && threads > 1);
+    if (pixels > 0 && tiled) {
+        rasterizeTiled(tris, settings, strategy, threads, zb, st);
+    } else if (pixels > 0) {
         if (settings.exactDepth) {
             rasterizeWith<DepthFormat::f32, true>(tris, settings, zb, st);  // the format is not used per fragment
         } else {

@@ -89,8 +89,25 @@ struct ZBufferResult {
     ZBufferStats stats;
 };
 
-// Rasterizes every triangle in submission order into a cleared width x height buffer.
+// Rasterizes every triangle in submission order into a cleared width x height buffer. Runs on the
+// calling thread's oneTBB arena, within its tbb::global_control limit (docs/rasterizer.md: Tiles).
 ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings);
+
+// How rasterize() runs. Every choice gives byte-identical results (tests/test_raster_tiles.cpp);
+// the defaults are what the benchmark measured fastest, the others exist for tests and benchmarks.
+struct RasterStrategy {
+    enum class Path : uint8_t {
+        automatic,  // plainWalk on one thread, tiled otherwise
+        plainWalk,  // the reference: one in-order walk through forEachFragment (raster_core.h)
+        tiled,      // binned into tiles, each tile's triangles in submission order, tiles in parallel
+    };
+    Path path = Path::automatic;
+    bool allowAvx2 = true;  // tiled: the AVX2 kernel when the CPU has it (else the baseline SSE2 one)
+    int tileShift = 0;      // tiled: tiles of 2^tileShift pixels square; 0 = default (kDefaultTileShift)
+};
+constexpr int kDefaultTileShift = 7;
+ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings,
+                        const RasterStrategy &strategy);
 
 // Fills the stats that follow from the per-pixel counts (covered pixels, ratios, histogram).
 void finishZBufferStats(const ZBuffer &zb, ZBufferStats *stats);

@@ -44,7 +44,17 @@
 
 namespace va {
 
+// The implementation lives in an inline namespace named after the instruction set the including
+// translation unit is compiled for (raster_avx2.cpp defines VA_RASTER_ISA as avx2 before including
+// this header): inline functions and template instantiations compiled with -mavx2 then have their
+// own mangled names, so the linker can never hand an AVX2 body to a caller of the baseline build
+// (Embree's `namespace isa` scheme). Callers write raster_detail::name as before.
+#ifndef VA_RASTER_ISA
+#define VA_RASTER_ISA base
+#endif
+
 namespace raster_detail {
+inline namespace VA_RASTER_ISA {
 
 // Range of fixed-point coordinates the int64 edge functions hold without overflow. With
 // |x|, |y| <= 2^29 every vertex difference is below 2^30 + 2^29 < 2^31, each product of two
@@ -151,13 +161,93 @@ inline EdgeSetup setupEdge(int64_t ax, int64_t ay, int64_t bx, int64_t by, int64
     return e;
 }
 
+// Pixel-center box of a triangle: the centers (x + 0.5, y + 0.5) inside its vertex box, before
+// clamping. x*one + half >= minX <=> x >= ceil((minX - half) / one) = (minX - half + one - 1) >> bits
+// (arithmetic shift floors, also for negatives), and x*one + half <= maxX <=> x <= (maxX - half) >> bits.
+inline int64_t firstCenter(int64_t minCoord) { return (minCoord - kHalf + kSubpixelOne - 1) >> kSubpixelBits; }
+inline int64_t lastCenter(int64_t maxCoord) { return (maxCoord - kHalf) >> kSubpixelBits; }
+
+// Coverage of one oriented triangle (positive signed area; steps 3-4 of the walk below) over the
+// pixel-center box [bx0, bx1] x [by0, by1], which must lie inside the triangle's own box of centers
+// (a tile's part of it, or all of it): `frag(size_t pixel, int64_t x, int64_t y)` is called once
+// for every covered center of the box, pixel = y * W + x. ext is the larger vertex extent
+// (maxX - minX, maxY - minY) in fixed point. Exact integer tests: any sub-box of the triangle's box
+// gets exactly the covered centers that lie in it, whichever of the three paths it takes.
+template <class Frag>
+inline void coverTriangle(int64_t x0, int64_t y0, int64_t x1, int64_t y1, int64_t x2, int64_t y2, int64_t ext,
+                          int64_t bx0, int64_t bx1, int64_t by0, int64_t by1, size_t W, Frag &&frag) {
+    // Edge functions at the box's first center; edge k is the one opposite vertex k.
+    const int64_t sx = bx0 * kSubpixelOne + kHalf, sy = by0 * kSubpixelOne + kHalf;
+    const EdgeSetup e0 = setupEdge(x1, y1, x2, y2, sx, sy);
+    const EdgeSetup e1 = setupEdge(x2, y2, x0, y0, sx, sy);
+    const EdgeSetup e2 = setupEdge(x0, y0, x1, y1, sx, sy);
+
+    int64_t r0 = e0.value, r1 = e1.value, r2 = e2.value;
+    const int64_t boxW = bx1 - bx0 + 1, boxH = by1 - by0 + 1;
+    if (((boxW - 1) | (boxH - 1)) < 8 && ext <= kBlockExtent) {
+        // Small (most triangles of a dense mesh): one 4 x 4 or 8 x 8 block of inside tests
+        // ((w-1)|(h-1) < n <=> both sides <= n for n a power of two), then the set bits.
+        const int32_t r[3] = {int32_t(r0), int32_t(r1), int32_t(r2)};
+        const int32_t stepX[3] = {int32_t(e0.stepX), int32_t(e1.stepX), int32_t(e2.stepX)};
+        const int32_t stepY[3] = {int32_t(e0.stepY), int32_t(e1.stepY), int32_t(e2.stepY)};
+        const uint64_t cover = ((boxW - 1) | (boxH - 1)) < 4 ? blockCoverage<4, 4>(r, stepX, stepY)
+                                                           : blockCoverage<8, 8>(r, stepX, stepY);
+        // Bits of the block inside the box: boxW columns of each of the first boxH rows.
+        const uint64_t boxBits = ((uint64_t(1) << boxW) - 1) * (kRowStarts >> (64 - 8 * boxH));
+        uint64_t mask = cover & boxBits;
+        while (mask) {
+            const int bit = std::countr_zero(mask);
+            mask &= mask - 1;
+            const int64_t x = bx0 + (bit & 7), y = by0 + (bit >> 3);
+            frag(size_t(y) * W + size_t(x), x, y);
+        }
+    } else if (boxW < kSpanMinWidth) {
+        // Narrow box: test every center, stepping the edge functions exactly.
+        for (int64_t y = by0; y <= by1; ++y) {
+            const size_t row = size_t(y) * W;
+            int64_t c0 = r0, c1 = r1, c2 = r2;
+            for (int64_t x = bx0; x <= bx1; ++x) {
+                if ((c0 | c1 | c2) >= 0) frag(row + size_t(x), x, y);
+                c0 += e0.stepX;
+                c1 += e1.stepX;
+                c2 += e2.stepX;
+            }
+            r0 += e0.stepY;
+            r1 += e1.stepY;
+            r2 += e2.stepY;
+        }
+    } else {
+        // Wide box: per row, edge k covers offset j (x = bx0 + j) iff r_k + j * stepX_k >= 0:
+        //   stepX > 0: j >= ceil(-r / stepX) = -floor(r / stepX)
+        //   stepX < 0: j <= floor(r / -stepX)
+        //   stepX = 0: every j if r >= 0, none otherwise.
+        const int64_t lastJ = bx1 - bx0;
+        const EdgeSetup *edges[3] = {&e0, &e1, &e2};
+        for (int64_t y = by0; y <= by1; ++y) {
+            const int64_t r[3] = {r0, r1, r2};
+            int64_t lo = 0, hi = lastJ;
+            for (int k = 0; k < 3; ++k) {
+                const int64_t s = edges[k]->stepX;
+                if (s > 0) lo = std::max(lo, -floorDiv(r[k], s));
+                else if (s < 0) hi = std::min(hi, floorDiv(r[k], -s));
+                else if (r[k] < 0) hi = -1;
+            }
+            const size_t row = size_t(y) * W;
+            for (int64_t x = bx0 + lo; x <= bx0 + hi; ++x) frag(row + size_t(x), x, y);
+            r0 += e0.stepY;
+            r1 += e1.stepY;
+            r2 += e2.stepY;
+        }
+    }
+}
+
 // The walk for one projection (see the contract above; the steps per triangle):
 //   1. the bounding box of the *pixel centers* it may cover, clamped to the viewport; empty box ->
 //      done (the common case for the benchmark scene's sub-pixel triangles: no edge setup at all);
 //   2. orientation: twice the signed area in fixed point; zero -> skipped, negative (the front
 //      winding) -> swap v1, v2 so every triangle is walked with the same inside test;
 //   3. edge functions in int64 at the first center, stepped exactly by integer increments;
-//   4. coverage, by the size of the box (all give the same set of centers, exactly):
+//   4. coverage (coverTriangle), by the size of the box (all give the same set of centers, exactly):
 //      - small (box <= 8 x 8 centers, vertex extent <= 64 px): one 4 x 4 or 8 x 8 block of inside
 //        tests in 32-bit SIMD lanes into a bit mask, without data-dependent branches;
 //      - wide (box >= kSpanMinWidth): each row's covered span solved with integer floor division,
@@ -176,15 +266,11 @@ void walkFragments(const ScreenTriangles &tris, int width, int height, Sink &sin
         const int32_t *v = xy + 6 * t;
         int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
 
-        // Bounding box of the pixel centers it may cover: x*one + half >= minX
-        // <=> x >= ceil((minX - half) / one) = (minX - half + one - 1) >> bits (arithmetic shift
-        // floors, also for negatives), and x*one + half <= maxX <=> x <= (maxX - half) >> bits.
+        // Bounding box of the pixel centers it may cover, clamped to the viewport.
         const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
         const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
-        const int64_t bx0 = std::max<int64_t>((minX - kHalf + kSubpixelOne - 1) >> kSubpixelBits, 0);
-        const int64_t bx1 = std::min<int64_t>((maxX - kHalf) >> kSubpixelBits, W - 1);
-        const int64_t by0 = std::max<int64_t>((minY - kHalf + kSubpixelOne - 1) >> kSubpixelBits, 0);
-        const int64_t by1 = std::min<int64_t>((maxY - kHalf) >> kSubpixelBits, H - 1);
+        const int64_t bx0 = std::max<int64_t>(firstCenter(minX), 0), bx1 = std::min<int64_t>(lastCenter(maxX), W - 1);
+        const int64_t by0 = std::max<int64_t>(firstCenter(minY), 0), by1 = std::min<int64_t>(lastCenter(maxY), H - 1);
         if (bx0 > bx1 || by0 > by1) continue;  // no center inside the box (or box outside the viewport)
         if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed)
             continue;  // outside the representable range (kMaxFixed): a clip-stage contract violation
@@ -201,88 +287,22 @@ void walkFragments(const ScreenTriangles &tris, int width, int height, Sink &sin
         if (!plane.valid) continue;
         if (!sink.beginTriangle(t, area < 0)) continue;
 
-        // Edge functions at the box's first center; edge k is the one opposite vertex k.
-        const int64_t sx = bx0 * kSubpixelOne + kHalf, sy = by0 * kSubpixelOne + kHalf;
-        const EdgeSetup e0 = setupEdge(x1, y1, x2, y2, sx, sy);
-        const EdgeSetup e1 = setupEdge(x2, y2, x0, y0, sx, sy);
-        const EdgeSetup e2 = setupEdge(x0, y0, x1, y1, sx, sy);
-
         // One covered center: depth from the plane exactly as evalDepthPlane writes it
-        // ((a*px + b*py) + c, b*py shared by the row: the same IEEE product), then the sink.
+        // ((a*px + b*py) + c), then the sink.
         uint64_t triFragments = 0;
         const double pa = plane.a, pb = plane.b, pc = plane.c;
-        auto emit = [&](size_t idx, double px, double bpy) {
-            const double pv = (pa * px + bpy) + pc;
-            const double d = kPerspective ? 1.0 / pv : pv;
-            ++triFragments;
-            sink.fragment(idx, t, d);
-        };
-
-        int64_t r0 = e0.value, r1 = e1.value, r2 = e2.value;
-        const int64_t boxW = bx1 - bx0 + 1, boxH = by1 - by0 + 1;
-        if (((boxW - 1) | (boxH - 1)) < 8 && maxX - minX <= kBlockExtent && maxY - minY <= kBlockExtent) {
-            // Small (most triangles of a dense mesh): one 4 x 4 or 8 x 8 block of inside tests
-            // ((w-1)|(h-1) < n <=> both sides <= n for n a power of two), then the set bits.
-            const int32_t r[3] = {int32_t(r0), int32_t(r1), int32_t(r2)};
-            const int32_t stepX[3] = {int32_t(e0.stepX), int32_t(e1.stepX), int32_t(e2.stepX)};
-            const int32_t stepY[3] = {int32_t(e0.stepY), int32_t(e1.stepY), int32_t(e2.stepY)};
-            const uint64_t cover = ((boxW - 1) | (boxH - 1)) < 4 ? blockCoverage<4, 4>(r, stepX, stepY)
-                                                               : blockCoverage<8, 8>(r, stepX, stepY);
-            // Bits of the block inside the box: boxW columns of each of the first boxH rows.
-            const uint64_t boxBits = ((uint64_t(1) << boxW) - 1) * (kRowStarts >> (64 - 8 * boxH));
-            uint64_t mask = cover & boxBits;
-            while (mask) {
-                const int bit = std::countr_zero(mask);
-                mask &= mask - 1;
-                const int64_t x = bx0 + (bit & 7), y = by0 + (bit >> 3);
-                emit(size_t(y) * size_t(W) + size_t(x), double(x) + 0.5, pb * (double(y) + 0.5));
-            }
-        } else if (boxW < kSpanMinWidth) {
-            // Narrow box: test every center, stepping the edge functions exactly.
-            for (int64_t y = by0; y <= by1; ++y) {
-                const double bpy = pb * (double(y) + 0.5);
-                const size_t row = size_t(y) * size_t(W);
-                int64_t c0 = r0, c1 = r1, c2 = r2;
-                for (int64_t x = bx0; x <= bx1; ++x) {
-                    if ((c0 | c1 | c2) >= 0) emit(row + size_t(x), double(x) + 0.5, bpy);
-                    c0 += e0.stepX;
-                    c1 += e1.stepX;
-                    c2 += e2.stepX;
-                }
-                r0 += e0.stepY;
-                r1 += e1.stepY;
-                r2 += e2.stepY;
-            }
-        } else {
-            // Wide box: per row, edge k covers offset j (x = bx0 + j) iff r_k + j * stepX_k >= 0:
-            //   stepX > 0: j >= ceil(-r / stepX) = -floor(r / stepX)
-            //   stepX < 0: j <= floor(r / -stepX)
-            //   stepX = 0: every j if r >= 0, none otherwise.
-            const int64_t lastJ = bx1 - bx0;
-            const EdgeSetup *edges[3] = {&e0, &e1, &e2};
-            for (int64_t y = by0; y <= by1; ++y) {
-                const int64_t r[3] = {r0, r1, r2};
-                int64_t lo = 0, hi = lastJ;
-                for (int k = 0; k < 3; ++k) {
-                    const int64_t s = edges[k]->stepX;
-                    if (s > 0) lo = std::max(lo, -floorDiv(r[k], s));
-                    else if (s < 0) hi = std::min(hi, floorDiv(r[k], -s));
-                    else if (r[k] < 0) hi = -1;
-                }
-                if (lo <= hi) {
-                    const double bpy = pb * (double(y) + 0.5);
-                    const size_t row = size_t(y) * size_t(W);
-                    for (int64_t x = bx0 + lo; x <= bx0 + hi; ++x) emit(row + size_t(x), double(x) + 0.5, bpy);
-                }
-                r0 += e0.stepY;
-                r1 += e1.stepY;
-                r2 += e2.stepY;
-            }
-        }
+        coverTriangle(x0, y0, x1, y1, x2, y2, std::max(maxX - minX, maxY - minY), bx0, bx1, by0, by1, size_t(W),
+                      [&](size_t idx, int64_t x, int64_t y) {
+                          const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
+                          const double d = kPerspective ? 1.0 / pv : pv;
+                          ++triFragments;
+                          sink.fragment(idx, t, d);
+                      });
         sink.endTriangle(t, triFragments);
     }
 }
 
+}  // namespace VA_RASTER_ISA
 }  // namespace raster_detail
 
 // Walks every fragment of `tris` in a width x height viewport into `sink` (contract above).

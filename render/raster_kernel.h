@@ -1,0 +1,218 @@
+// The z-buffer's tile kernel (docs/rasterizer.md: Tiles, SIMD). Private to the rasterizer: included
+// by raster.cpp (baseline instruction set) and raster_avx2.cpp (-mavx2); each compiles its own copy
+// inside raster_core.h's instruction-set namespace and hands out function pointers through
+// shadeFunctionBase / shadeFunctionAvx2.
+//
+// A kernel call shades the triangles binned into one tile (a pixel rectangle), in submission order,
+// into the shared z-buffer; tiles are disjoint, so calls for different tiles may run concurrently.
+// Per triangle it does what walkFragments does (orientation, coverTriangle over the triangle's box
+// clipped to the tile, the depth plane at each covered center), but instead of testing each
+// fragment as it comes it collects them in a batch:
+//   1. coverage pushes (pixel, plane value, id) per covered center and counts fragments per pixel;
+//   2. at kBatch fragments (and at the end), the view depths d = 1 / v (or v) and the format's keys
+//      are computed for the whole batch in loops without branches, which the compiler turns into
+//      SIMD lanes (4 doubles with AVX2): IEEE division, conversion and comparison per lane give
+//      the same bits as the scalar code, so d and the keys are bit-identical to walkFragments';
+//   3. the depth test (LESS on the keys, selects) and the writes run in batch order, which is
+//      submission order: a pixel sees its fragments in the same order as in the plain walk.
+// Results are therefore byte-identical to the plain walk (raster.cpp's ZBufferSink) for any tiling.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+
+#include "render/depth_format_impl.h"
+#include "render/raster_core.h"
+
+namespace va::raster_detail {
+
+// One triangle binned into a tile. flags: kMultiTile set when the triangle's box of centers spans
+// more than one tile (its fragment count is then summed over tiles in multiCounts[multi]);
+// kFullTile set when every center of the tile is inside the triangle (whole-tile accept, decided
+// at binning from the tile's corner centers).
+struct BinEntry {
+    uint32_t t;      // triangle index (submission order)
+    uint32_t multi;  // index into the chunk's multiCounts when kMultiTile
+    uint32_t flags;
+};
+constexpr uint32_t kMultiTile = 1, kFullTile = 2;
+
+// The triangles one binning chunk (a run of consecutive triangles) put into one tile.
+struct BinList {
+    const BinEntry *entries = nullptr;
+    size_t count = 0;
+    uint32_t *multiCounts = nullptr;  // the chunk's per-multi-tile-triangle fragment counts (atomic adds)
+};
+
+// Everything a kernel call reads and writes besides its tile's bins.
+struct ShadeTarget {
+    const int32_t *xy;
+    const uint32_t *source;
+    const uint32_t *planeIndex;
+    const DepthPlane *planes;
+    const DepthEncoder *encoder;
+    uint32_t *fragmentsPerSource;  // may be null
+    bool concurrent;               // tiles run concurrently: shared counters take atomic adds
+    size_t width;
+    uint32_t *key;
+    uint32_t *id;
+    double *depth;
+    uint16_t *fragments;
+    uint16_t *passes;
+};
+
+// A tile: inclusive pixel rectangle, its bin lists in submission order (chunk order).
+struct TileWork {
+    int64_t x0, x1, y0, y1;
+    const BinList *lists;
+    size_t listCount;
+};
+
+// Sums over a tile; multi-tile triangles are counted as drawn after all tiles (multiCounts).
+struct TileCounts {
+    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawnSingle = 0;
+};
+
+using ShadeFn = void (*)(const ShadeTarget &, const TileWork &, TileCounts &);
+// The kernel for a depth format, projection and exactDepth, per instruction set.
+ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth);
+ShadeFn shadeFunctionAvx2(DepthFormat format, bool perspective, bool exactDepth);
+
+inline namespace VA_RASTER_ISA {
+
+constexpr size_t kBatch = 256;
+
+template <DepthFormat F, bool kPerspective, bool kExact>
+void shadeTile(const ShadeTarget &s, const TileWork &w, TileCounts &counts) {
+    alignas(64) double value[kBatch];  // plane value, then view depth
+    alignas(64) uint32_t keys[kBatch];
+    alignas(64) uint32_t pixel[kBatch];
+    alignas(64) uint32_t ids[kBatch];
+    size_t n = 0;
+    uint64_t passes = 0, outOfRange = 0;
+
+    // Steps 2 and 3 of the header comment for the n fragments collected so far.
+    auto flush = [&] {
+        if constexpr (kPerspective)
+            for (size_t i = 0; i < n; ++i) value[i] = 1.0 / value[i];
+        if constexpr (!kExact) {
+            // A local copy of the encoder: loads through s.encoder inside the loop keep GCC from
+            // vectorizing it (it cannot prove the key stores leave the encoder alone).
+            const DepthEncoder enc = *s.encoder;
+            uint32_t oor = 0;
+            for (size_t i = 0; i < n; ++i) {
+                bool o = false;
+                uint32_t k;
+                encodeDepth<F>(enc, value[i], k, o);
+                keys[i] = k;
+                oor += o ? 1 : 0;
+            }
+            outOfRange += oor;
+        }
+        uint32_t *const keyBuf = s.key, *const idBuf = s.id;
+        uint16_t *const passBuf = s.passes, *const fragBuf = s.fragments;
+        double *const depthBuf = s.depth;
+        uint64_t p = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const size_t idx = pixel[i];
+            const double d = value[i];
+            fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
+            // LESS: on equal keys (or equal depths) the first drawn fragment stays; selects, not a
+            // branch (about half the fragments pass, in no predictable pattern).
+            bool pass;
+            if constexpr (kExact) {
+                pass = d < depthBuf[idx];
+            } else {
+                const uint32_t oldKey = keyBuf[idx];
+                pass = keys[i] < oldKey;
+                keyBuf[idx] = pass ? keys[i] : oldKey;
+            }
+            idBuf[idx] = pass ? ids[i] : idBuf[idx];
+            depthBuf[idx] = pass ? d : depthBuf[idx];
+            passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
+            p += pass ? 1 : 0;
+        }
+        passes += p;
+        n = 0;
+    };
+
+    const size_t W = s.width;
+    uint64_t fragments = 0, drawnSingle = 0;
+    for (size_t l = 0; l < w.listCount; ++l) {
+        const BinList &list = w.lists[l];
+        for (size_t b = 0; b < list.count; ++b) {
+            const BinEntry e = list.entries[b];
+            const size_t t = e.t;
+            const int32_t *v = s.xy + 6 * t;
+            int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
+            const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
+            const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
+            // The triangle's box of centers clipped to the tile (binning guarantees it is not empty).
+            const int64_t bx0 = std::max(firstCenter(minX), w.x0), bx1 = std::min(lastCenter(maxX), w.x1);
+            const int64_t by0 = std::max(firstCenter(minY), w.y0), by1 = std::min(lastCenter(maxY), w.y1);
+            // Orientation as in walkFragments (binning dropped zero areas).
+            if ((x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0) < 0) {
+                std::swap(x1, x2);
+                std::swap(y1, y2);
+            }
+            const DepthPlane &plane = s.planes[s.planeIndex[t]];
+            const double pa = plane.a, pb = plane.b, pc = plane.c;
+            const uint32_t idValue = s.source[t] + 1;
+            uint64_t triFragments = 0;
+            auto frag = [&](size_t idx, int64_t x, int64_t y) {
+                // The flush reads and writes these kBatch fragments later: fetch their lines now.
+                __builtin_prefetch(s.key + idx, 1);
+                __builtin_prefetch(s.id + idx, 1);
+                __builtin_prefetch(s.depth + idx, 1);
+                __builtin_prefetch(s.fragments + idx, 1);
+                __builtin_prefetch(s.passes + idx, 1);
+                value[n] = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
+                pixel[n] = uint32_t(idx);
+                ids[n] = idValue;
+                ++triFragments;
+                if (++n == kBatch) flush();
+            };
+            if (e.flags & kFullTile) {
+                for (int64_t y = by0; y <= by1; ++y)
+                    for (int64_t x = bx0; x <= bx1; ++x) frag(size_t(y) * W + size_t(x), x, y);
+            } else {
+                coverTriangle(x0, y0, x1, y1, x2, y2, std::max(maxX - minX, maxY - minY), bx0, bx1, by0, by1, W,
+                              frag);
+            }
+
+            fragments += triFragments;
+            if (e.flags & kMultiTile) {
+                if (triFragments)
+                    std::atomic_ref<uint32_t>(list.multiCounts[e.multi]).fetch_add(uint32_t(triFragments),
+                                                                                    std::memory_order_relaxed);
+            } else {
+                drawnSingle += triFragments != 0 ? 1 : 0;
+            }
+            if (s.fragmentsPerSource && triFragments) {
+                // Sums modulo 2^32 in any order: the same result for any tiling and thread count.
+                uint32_t &slot = s.fragmentsPerSource[s.source[t]];
+                if (s.concurrent) std::atomic_ref<uint32_t>(slot).fetch_add(uint32_t(triFragments), std::memory_order_relaxed);
+                else slot += uint32_t(triFragments);
+            }
+        }
+    }
+    flush();
+    counts.fragments += fragments;
+    counts.passes += passes;
+    counts.outOfRange += outOfRange;
+    counts.drawnSingle += drawnSingle;
+}
+
+// The kernel for a format, projection and exactDepth (exactDepth ignores the format per fragment).
+inline ShadeFn selectShade(DepthFormat format, bool perspective, bool exactDepth) {
+    if (exactDepth)
+        return perspective ? &shadeTile<DepthFormat::f32, true, true> : &shadeTile<DepthFormat::f32, false, true>;
+    return dispatchDepthFormat(format, [&]<DepthFormat F>() -> ShadeFn {
+        return perspective ? &shadeTile<F, true, false> : &shadeTile<F, false, false>;
+    });
+}
+
+}  // namespace VA_RASTER_ISA
+
+}  // namespace va::raster_detail
