@@ -1,10 +1,16 @@
 #include "render/raycast.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
 
 #include <embree3/rtcore.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <sys/mman.h>
+#include <tbb/parallel_for.h>
 
 namespace va {
 
@@ -24,8 +30,11 @@ RTCDevice sharedDevice() {
     return device;
 }
 
-// Ray setup shared by castPrimary and castPrimaryRaw: origin and direction in the scene's
-// float frame (relative to the origin) for pixel (x, y).
+// Ray setup shared by castPrimary, castPrimaryRaw and primaryRay: origin and direction in the
+// scene's float frame (relative to the origin) for pixel (x, y). A ray is the sum of a column term
+// (pixel x) and a row term (pixel y), both in double, so a packet can take them from per-view
+// tables (PacketRays) and still produce bit-identical rays: the same double operations in the same
+// order, then one rounding to float.
 struct RayGen {
     Vec3 eyeRel;        // eye - origin
     Vec3 right, up, fw; // camera basis
@@ -45,18 +54,26 @@ struct RayGen {
     }
     // Perspective: o = eye, dir = right*u + up*v + forward (view z = -1: t is the view depth).
     // Orthographic: o = eye + right*u + up*v, dir = forward.
-    void make(int x, int y, float o[3], float d[3]) const {
-        const double u = ax * (x + 0.5) + bx, v = ay * (y + 0.5) + by;
+    Vec3 column(int x) const {
+        const double u = ax * (x + 0.5) + bx;
+        return ortho ? eyeRel + right * u : right * u;
+    }
+    Vec3 row(int y) const {
+        const double v = ay * (y + 0.5) + by;
+        return up * v;
+    }
+    void combine(const Vec3 &col, const Vec3 &row, float o[3], float d[3]) const {
         if (ortho) {
-            const Vec3 p = eyeRel + right * u + up * v;
+            const Vec3 p = col + row;
             o[0] = float(p.x), o[1] = float(p.y), o[2] = float(p.z);
             d[0] = float(fw.x), d[1] = float(fw.y), d[2] = float(fw.z);
         } else {
-            const Vec3 r = right * u + up * v + fw;
+            const Vec3 r = col + row + fw;
             o[0] = float(eyeRel.x), o[1] = float(eyeRel.y), o[2] = float(eyeRel.z);
             d[0] = float(r.x), d[1] = float(r.y), d[2] = float(r.z);
         }
     }
+    void make(int x, int y, float o[3], float d[3]) const { combine(column(x), row(y), o, d); }
 };
 
 }  // namespace
@@ -137,25 +154,103 @@ bool RayScene::build(const MeshView &mesh, size_t vertexCount, const std::vector
 }
 
 namespace {
-// Fills a 16-ray packet for the 4x4 tile at (tx, ty); lanes outside the image are invalid.
-void fillPacket(const RayGen &gen, const Camera &cam, int tx, int ty, RTCRayHit16 &rh, int valid[16]) {
-    for (int i = 0; i < 16; ++i) {
-        const int x = tx + (i & 3), y = ty + (i >> 2);
-        valid[i] = (x < cam.width && y < cam.height) ? -1 : 0;
-        float o[3] = {0, 0, 0}, d[3] = {0, 0, -1};
-        if (valid[i]) gen.make(x, y, o, d);
-        rh.ray.org_x[i] = o[0], rh.ray.org_y[i] = o[1], rh.ray.org_z[i] = o[2];
-        rh.ray.dir_x[i] = d[0], rh.ray.dir_y[i] = d[1], rh.ray.dir_z[i] = d[2];
-        rh.ray.tnear[i] = float(cam.nearZ);
-        rh.ray.tfar[i] = float(cam.farZ);
-        rh.ray.time[i] = 0;
-        rh.ray.mask[i] = 0xFFFFFFFFu;
-        rh.ray.id[i] = unsigned(i);
-        rh.ray.flags[i] = 0;
-        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
-    }
+// v = n copies of x, asking the kernel to back v's memory with transparent huge pages where it can.
+// A 1080p image buffer is 8 MB of fresh memory on every call: faulting it in as 2,025 pages of
+// 4 KiB took 3.5 ms per buffer here, more than writing it, against 0.4 ms in 2 MiB pages; the
+// writes of a 4x4 packet span 4 rows, 4 pages apart at 4 KiB, one page at 2 MiB. (Embree asks the
+// same for its BVH.) Only a hint: where the kernel's THP setting is "never" nothing changes.
+template <class T>
+void assignOnLargePages(std::vector<T> &v, size_t n, T x) {
+    v.clear();
+    v.reserve(n);  // allocates without touching the pages
+#ifdef MADV_HUGEPAGE
+    constexpr uintptr_t kPage = 4096;
+    const uintptr_t b = (reinterpret_cast<uintptr_t>(v.data()) + kPage - 1) & ~(kPage - 1);
+    const uintptr_t e = (reinterpret_cast<uintptr_t>(v.data() + n)) & ~(kPage - 1);
+    if (e > b) madvise(reinterpret_cast<void *>(b), e - b, MADV_HUGEPAGE);
+#endif
+    v.assign(n, x);
 }
+
+// dst[0 .. n) = src[0 .. n) for 4-byte elements, with non-temporal stores where the target is
+// 16-byte aligned: a frame's output (16 MB and more) would otherwise pass through the caches and
+// evict the BVH nodes the next packets need.
+template <class T>
+void streamCopy(const T *src, size_t n, T *dst) {
+    static_assert(sizeof(T) == 4);
+    size_t i = 0;
+#if defined(__SSE2__)
+    for (; i < n && (reinterpret_cast<uintptr_t>(dst + i) & 15); ++i) dst[i] = src[i];
+    for (; i + 4 <= n; i += 4)
+        _mm_stream_si128(reinterpret_cast<__m128i *>(dst + i), _mm_loadu_si128(reinterpret_cast<const __m128i *>(src + i)));
+    _mm_sfence();
+#endif
+    for (; i < n; ++i) dst[i] = src[i];
+}
+
+// Primary rays are traced in 4x4 packets (rtcIntersect16), 16 packets to a 16x16 tile, tiles left to
+// right in bands of 16 rows. A band is one contiguous range of every per-pixel buffer (16 whole
+// rows), so bands run in parallel without two threads writing the same cache line (except the one
+// line at each band's ends when a buffer does not start on a line boundary); each pixel's result
+// depends on its ray alone, so the images are identical for any thread count. A 16x16 tile's rays
+// stay within a small cone, so consecutive packets reuse the same BVH nodes and triangles in cache.
+constexpr int kPacket = 4;  // packet side: 4x4 rays
+constexpr int kTile = 16;   // tile side and band height, in pixels
+
+// Per-view ray tables: RayGen's column and row terms for every pixel column and row, and one
+// packet buffer per band with the lane constants set once; a packet then costs 3 + 3 double adds and
+// 3 conversions per ray.
+struct PacketRays {
+    const RayGen &gen;
+    const Camera &cam;
+    std::vector<Vec3> cols, rows;
+
+    PacketRays(const RayGen &g, const Camera &c) : gen(g), cam(c), cols(size_t(c.width)), rows(size_t(c.height)) {
+        for (int x = 0; x < c.width; ++x) cols[size_t(x)] = g.column(x);
+        for (int y = 0; y < c.height; ++y) rows[size_t(y)] = g.row(y);
+    }
+    // The fields Embree never writes, and the perspective origin (the eye, for every ray).
+    void init(RTCRayHit16 &rh) const {
+        for (int i = 0; i < 16; ++i) {
+            rh.ray.org_x[i] = float(gen.eyeRel.x), rh.ray.org_y[i] = float(gen.eyeRel.y);
+            rh.ray.org_z[i] = float(gen.eyeRel.z);
+            rh.ray.tnear[i] = float(cam.nearZ);
+            rh.ray.time[i] = 0;
+            rh.ray.mask[i] = 0xFFFFFFFFu;
+            rh.ray.id[i] = unsigned(i);  // the lane, for primaryFilter's tie state
+            rh.ray.flags[i] = 0;
+            rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.primID[i] = 0;
+        }
+    }
+    // The rays of the packet whose top-left pixel is (px, py); lanes outside the image are invalid
+    // (lane i is pixel (px + i % 4, py + i / 4)).
+    void fill(int px, int py, RTCRayHit16 &rh, int valid[16]) const {
+        for (int i = 0; i < 16; ++i) {
+            const int x = px + (i & 3), y = py + (i >> 2);
+            valid[i] = (x < cam.width && y < cam.height) ? -1 : 0;
+            float o[3], d[3];
+            gen.combine(cols[size_t(valid[i] ? x : 0)], rows[size_t(valid[i] ? y : 0)], o, d);
+            if (gen.ortho) rh.ray.org_x[i] = o[0], rh.ray.org_y[i] = o[1], rh.ray.org_z[i] = o[2];
+            rh.ray.dir_x[i] = d[0], rh.ray.dir_y[i] = d[1], rh.ray.dir_z[i] = d[2];
+            rh.ray.tfar[i] = float(cam.farZ);
+            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        }
+    }
+    int bands() const { return (cam.height + kTile - 1) / kTile; }
+    // Calls fn(px, py) for the packets of band b in tracing order: tiles left to right, the 16
+    // packets of a tile row by row; onTile(x0, y0, y1) before each tile whose pixels are columns
+    // [x0, x0 + kTile) of rows [y0, y1).
+    template <class TileFn, class Fn>
+    void forEachPacket(int b, TileFn onTile, Fn fn) const {
+        const int y0 = b * kTile, y1 = std::min(cam.height, y0 + kTile);
+        for (int tx = 0; tx < cam.width; tx += kTile) {
+            onTile(tx, y0, y1);
+            for (int py = y0; py < y1; py += kPacket)
+                for (int px = tx; px < std::min(cam.width, tx + kTile); px += kPacket) fn(px, py);
+        }
+    }
+};
 }  // namespace
 
 namespace {
@@ -201,51 +296,70 @@ void primaryFilter(const RTCFilterFunctionNArguments *args) {
     }
 }
 
-// The tile loop shared by both castPrimary overloads (kBary: also write barycentrics).
-// kTies: ctx is a FilterContext that tracks ties per lane (reset per packet).
+// One band of castPrimary (kBary: also write barycentrics; kTies: the context's filter tracks ties
+// per lane, reset per packet). `fc` is this band's own copy of the context (tie state is per packet).
 template <bool kBary, bool kTies>
-void castTiles(RTCScene scene, RTCIntersectContext *ctx, const RayGen &gen, const Camera &cam,
-               const std::vector<uint32_t> &primToSource, RaycastImage &img, RaycastStats &st) {
+void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int band,
+              const std::vector<uint32_t> &primToSource, RaycastImage &img, RaycastStats &st) {
     alignas(64) RTCRayHit16 rh;
     alignas(64) int valid[16];
-    for (int ty = 0; ty < cam.height; ty += 4)
-        for (int tx = 0; tx < cam.width; tx += 4) {
-            fillPacket(gen, cam, tx, ty, rh, valid);
-            if constexpr (kTies) reinterpret_cast<FilterContext *>(ctx)->resetLanes();
-            rtcIntersect16(valid, scene, ctx, &rh);
-            ++st.packets;
-            for (int i = 0; i < 16; ++i) {
-                if (!valid[i]) continue;
-                ++st.rays;
-                if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-                ++st.hits;
-                const size_t p = size_t(ty + (i >> 2)) * cam.width + (tx + (i & 3));
-                img.id[p] = 1 + primToSource[rh.hit.primID[i]];
-                img.depth[p] = rh.ray.tfar[i];
-                if constexpr (kBary) {
-                    img.u[p] = rh.hit.u[i];
-                    img.v[p] = rh.hit.v[i];
-                }
+    rays.init(rh);
+    const size_t w = size_t(img.width);
+    const int y0 = band * kTile, y1 = std::min(img.height, y0 + kTile);
+    const size_t begin = size_t(y0) * w, count = size_t(y1 - y0) * w;
+    // The band is traced into buffers of its own, which stay in cache while its tiles write them
+    // packet by packet, and then copied to its contiguous range of the image in one go.
+    std::vector<uint32_t> id(count);
+    std::vector<float> depth(count), u(kBary ? count : 0), v(kBary ? count : 0);
+    st.rays += count;
+    rays.forEachPacket(band, [](int, int, int) {}, [&](int px, int py) {
+        rays.fill(px, py, rh, valid);
+        if constexpr (kTies) fc.resetLanes();
+        rtcIntersect16(valid, scene, &fc.ctx, &rh);
+        ++st.packets;
+        // Branch-free over the lanes: a miss keeps tfar = far and geomID invalid, and Embree leaves
+        // primID as it was (init()'s 0 or an earlier hit), always a valid index.
+        for (int i = 0; i < 16; ++i) {
+            if (!valid[i]) continue;
+            const bool hit = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+            st.hits += hit;
+            const size_t p = size_t(py - y0 + (i >> 2)) * w + size_t(px + (i & 3));
+            id[p] = hit ? 1 + primToSource[rh.hit.primID[i]] : 0;
+            depth[p] = hit ? rh.ray.tfar[i] : float(INFINITY);
+            if constexpr (kBary) {
+                u[p] = hit ? rh.hit.u[i] : 0.0f;
+                v[p] = hit ? rh.hit.v[i] : 0.0f;
             }
         }
+    });
+    streamCopy(id.data(), count, img.id.data() + begin);
+    streamCopy(depth.data(), count, img.depth.data() + begin);
+    if constexpr (kBary) {
+        streamCopy(u.data(), count, img.u.data() + begin);
+        streamCopy(v.data(), count, img.v.data() + begin);
+    }
+}
+
+// Every band, in parallel (tbb; threads as tbb::global_control allows). Stats are summed per band
+// in band order, so they too are identical for any thread count.
+template <bool kBary, bool kTies>
+void castBands(RTCScene scene, const FilterContext &proto, const PacketRays &rays,
+               const std::vector<uint32_t> &primToSource, RaycastImage &img, RaycastStats &st) {
+    std::vector<RaycastStats> perBand(size_t(rays.bands()));
+    tbb::parallel_for(0, rays.bands(), [&](int b) {
+        FilterContext fc = proto;
+        castBand<kBary, kTies>(scene, fc, rays, b, primToSource, img, perBand[size_t(b)]);
+    });
+    for (const RaycastStats &s : perBand) {
+        st.rays += s.rays;
+        st.hits += s.hits;
+        st.packets += s.packets;
+    }
 }
 }  // namespace
 
 RaycastImage RayScene::castPrimary(const Camera &cam, RaycastStats *stats) const {
-    const Impl &m = *impl_;
-    RaycastImage img;
-    img.width = cam.width;
-    img.height = cam.height;
-    img.id.assign(size_t(cam.width) * cam.height, 0);
-    img.depth.assign(size_t(cam.width) * cam.height, INFINITY);
-    const RayGen gen(cam, m.origin);
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    RaycastStats st;
-    castTiles<false, false>(m.scene, &ctx, gen, cam, m.primToSource, img, st);
-    if (stats) *stats = st;
-    return img;
+    return castPrimary(cam, PrimaryOptions{}, stats);
 }
 
 RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt, RaycastStats *stats) const {
@@ -254,11 +368,11 @@ RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt,
     img.width = cam.width;
     img.height = cam.height;
     const size_t n = size_t(cam.width) * cam.height;
-    img.id.assign(n, 0);
-    img.depth.assign(n, INFINITY);
+    assignOnLargePages(img.id, n, 0u);
+    assignOnLargePages(img.depth, n, float(INFINITY));
     if (opt.keepBarycentrics) {
-        img.u.assign(n, 0.0f);
-        img.v.assign(n, 0.0f);
+        assignOnLargePages(img.u, n, 0.0f);
+        assignOnLargePages(img.v, n, 0.0f);
     }
     const RayGen gen(cam, m.origin);
     FilterContext rc;
@@ -299,13 +413,16 @@ RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt,
         rc.ctx.filter = primaryFilter;
     }
     RaycastStats st;
-    const bool ties = rc.primToSource != nullptr;
-    if (opt.keepBarycentrics)
-        ties ? castTiles<true, true>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st)
-             : castTiles<true, false>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
-    else
-        ties ? castTiles<false, true>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st)
-             : castTiles<false, false>(m.scene, &rc.ctx, gen, cam, m.primToSource, img, st);
+    if (n) {
+        const PacketRays rays(gen, cam);
+        const bool ties = rc.primToSource != nullptr;
+        if (opt.keepBarycentrics)
+            ties ? castBands<true, true>(m.scene, rc, rays, m.primToSource, img, st)
+                 : castBands<true, false>(m.scene, rc, rays, m.primToSource, img, st);
+        else
+            ties ? castBands<false, true>(m.scene, rc, rays, m.primToSource, img, st)
+                 : castBands<false, false>(m.scene, rc, rays, m.primToSource, img, st);
+    }
     if (stats) *stats = st;
     return img;
 }
@@ -313,18 +430,20 @@ RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt,
 uint64_t RayScene::castPrimaryRaw(const Camera &cam) const {
     const Impl &m = *impl_;
     const RayGen gen(cam, m.origin);
+    const PacketRays rays(gen, cam);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     alignas(64) RTCRayHit16 rh;
     alignas(64) int valid[16];
+    rays.init(rh);
     uint64_t hits = 0;
-    for (int ty = 0; ty < cam.height; ty += 4)
-        for (int tx = 0; tx < cam.width; tx += 4) {
-            fillPacket(gen, cam, tx, ty, rh, valid);
+    for (int b = 0; b < rays.bands(); ++b)
+        rays.forEachPacket(b, [](int, int, int) {}, [&](int px, int py) {
+            rays.fill(px, py, rh, valid);
             rtcIntersect16(valid, m.scene, &ctx, &rh);
             for (int i = 0; i < 16; ++i) hits += valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-        }
+        });
     return hits;
 }
 

@@ -3,7 +3,8 @@
 // direction with view-space z = -1 so the hit distance t is the view depth, t in [near, far].
 //
 // Two kinds of queries:
-//  - primary rays, whole images, in 4x4 tiles traced as rtcIntersect16 packets (castPrimary);
+//  - primary rays, whole images, as 4x4 rtcIntersect16 packets over 16x16 tiles, bands of tiles in
+//    parallel (castPrimary; identical results for any thread count);
 //  - single rays in the scene's float frame (intersect / occluded), for secondary rays
 //    (render/effects.h) and tests.
 //
@@ -89,13 +90,16 @@ class RayScene {
     bool build(const MeshView &mesh, size_t vertexCount, const std::vector<uint32_t> &triangles, Vec3 origin,
                std::string *err);
 
-    // One ray per pixel center, in 4x4 tiles traced as rtcIntersect16 packets.
+    // One ray per pixel center, traced as 4x4 rtcIntersect16 packets over 16x16 tiles; bands of 16
+    // rows run in parallel (oneTBB, as many threads as tbb::global_control allows). The result does not
+    // depend on the thread count.
     RaycastImage castPrimary(const Camera &cam, RaycastStats *stats) const;
     // The same rays with options (back-face rejection, barycentrics). With default options the
     // result equals castPrimary(cam, stats).
     RaycastImage castPrimary(const Camera &cam, const PrimaryOptions &opt, RaycastStats *stats) const;
 
-    // The raw anchor for benchmarks: the same rays, rtcIntersect16, no id mapping or depth output.
+    // The raw anchor for benchmarks: the same rays and packets in the same order, rtcIntersect16 on the
+    // calling thread, no id mapping or depth output; returns the hits.
     uint64_t castPrimaryRaw(const Camera &cam) const;
 
     // The primary ray of pixel (x, y) exactly as castPrimary traces it (float frame; tnear = near,
