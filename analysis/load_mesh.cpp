@@ -72,6 +72,7 @@ public:
         const size_t nv = m_->positions.size();
         for (const auto &v : vs)
             if (!v.is_valid() || size_t(v.idx()) >= nv) {
+                if (!badIndexFaces) badFace = {uint64_t(fh.idx()), int64_t(v.idx()), nv};
                 ++m_->facesDropped;
                 ++badIndexFaces;
                 return fh;
@@ -142,6 +143,11 @@ public:
     size_t n_edges() const override { return 0; }
 
     uint64_t badIndexFaces = 0, tooFewFaces = 0;
+    struct {
+        uint64_t face;      // the first face with an invalid index (file order, from 0)
+        int64_t index;      // that index
+        size_t vertices;    // vertices read when the face came
+    } badFace{};
 
 private:
     RawMesh *m_;
@@ -259,7 +265,8 @@ std::string_view firstWord(std::string_view l) {
 // vertices. We count "v" and "f" lines; when the vertex count differs from what the reader stored,
 // the first vertex line whose three coordinates are not finite numbers is named in the error.
 // (A non-finite coordinate therefore cannot come from an OBJ file; the other formats hand NaN over
-// and buildScene counts the triangles as non-finite.)
+// and loadMeshFile refuses it.) A face index outside the vertex list (1..n, or -1..-k relative to the
+// k vertices before it) is refused too, naming the face's line: OpenMesh would drop the face.
 bool checkObj(const std::string &path, const std::string &text, size_t positionsRead, uint64_t *faceLines,
               std::string *err) {
     uint64_t vLines = 0, fLines = 0;
@@ -270,6 +277,30 @@ bool checkObj(const std::string &path, const std::string &text, size_t positions
         return true;
     });
     *faceLines = fLines;
+    std::string bad;
+    uint64_t vSoFar = 0;
+    forEachLine(text, [&](size_t n, std::string_view l) {
+        const std::string_view w = firstWord(l);
+        if (w == "v") ++vSoFar;
+        if (w != "f") return true;
+        const std::string line(l);
+        std::istringstream in(line.substr(line.find('f') + 1));
+        std::string corner;
+        while (in >> corner) {
+            const long long i = std::strtoll(corner.c_str(), nullptr, 10);  // "7/1/2": the vertex is 7
+            if ((i > 0 && uint64_t(i) <= vLines) || (i < 0 && uint64_t(-i) <= vSoFar)) continue;
+            bad = path + ":" + std::to_string(n) + ": face '" + line + "': vertex index " + std::to_string(i) +
+                  " is out of range (the file has " + std::to_string(vLines) +
+                  " vertices, counting from 1); fix the index or add the vertex";
+            return false;
+        }
+        return true;
+    });
+    // A skipped vertex (below) is the root cause of any index error: report it first.
+    if (!bad.empty() && vLines == positionsRead) {
+        *err = bad;
+        return false;
+    }
     if (vLines == positionsRead) return true;
     std::string msg;
     forEachLine(text, [&](size_t n, std::string_view l) {
@@ -700,8 +731,17 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
                              "), counted as dropped");
     }
     if (rec.badIndexFaces)
-        m.warnings.push_back(path + ": " + std::to_string(rec.badIndexFaces) +
-                             " face(s) with invalid vertex indices dropped");
+        return fail(path + ": face " + std::to_string(rec.badFace.face) + " (counting from 0) has vertex index " +
+                    std::to_string(rec.badFace.index) + ", out of range (the file has " +
+                    std::to_string(rec.badFace.vertices) + " vertices); fix the index or add the vertex");
+    // A NaN or infinite coordinate means a damaged file (NaN passes every range test downstream).
+    for (size_t i = 0; i < m.positions.size(); ++i)
+        if (!isFinite(m.positions[i])) {
+            char c[96];
+            std::snprintf(c, sizeof c, "%g, %g, %g", m.positions[i].x, m.positions[i].y, m.positions[i].z);
+            return fail(path + ": vertex " + std::to_string(i) + " (counting from 0) has a non-finite coordinate (" + c +
+                        "); the file is damaged: write finite numbers");
+        }
     if (rec.tooFewFaces)
         m.warnings.push_back(path + ": " + std::to_string(rec.tooFewFaces) +
                              " face(s) with fewer than 3 distinct vertices dropped");

@@ -499,6 +499,15 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
         }
         const Mat4 worldFromObject = Mat4::translate(t) * Mat4::rotateXYZDegrees(rot) * Mat4::scale(s);
         for (auto &v : o.geometry.positions) v = transformPoint(worldFromObject, v);
+        // The mesh's own coordinates are finite (loadMeshFile refuses others): a non-finite one now
+        // comes from the transform overflowing. Point at the key that scales or moves the most.
+        for (size_t k = 0; k < o.geometry.positions.size(); ++k) {
+            if (isFinite(o.geometry.positions[k])) continue;
+            const char *key = j.contains("scale") ? "scale" : j.contains("translate") ? "translate" : "rotate_deg";
+            r.fail(p / key, "the transform maps vertex " + std::to_string(k) + " of '" + o.mesh +
+                                "' (counting from 0) to a non-finite position; use a smaller scale or translation");
+            return failed();
+        }
         // An odd number of negative scale factors mirrors the mesh, turning counter-clockwise into
         // clockwise: swap two corners so the front face stays counter-clockwise.
         if (s.x * s.y * s.z < 0)

@@ -111,6 +111,11 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
         fail(err);
         return false;
     }
+    // An explicit views file with no views is a mistake to report, not a reason to pick others.
+    if (views->empty() && !o.views.empty()) {
+        fail("--views " + o.views + ": the file has no views; give at least one view");
+        return false;
+    }
     if (views->empty()) {
         *views = orbitViews(*scene, 4);
         std::fprintf(stderr, "visaudit: %s has no views; using --views orbit:4\n",

@@ -4,6 +4,17 @@
 
 namespace va {
 
+namespace {
+// v / |v| for any finite non-zero v. |v|^2 overflows for components above ~1e154 and underflows
+// below ~1e-154 (a valid direction would then read as infinite or zero): there only, v is first
+// scaled by its largest component, so ordinary vectors keep their usual rounding.
+Vec3 direction(Vec3 v) {
+    const double l2 = dot(v, v);
+    if (std::isnormal(l2)) return v / std::sqrt(l2);
+    return normalize(v / maxAbs(v));
+}
+}  // namespace
+
 bool makeCamera(const CameraSpec &s, Camera *cam, std::string *err) {
     auto fail = [&](const std::string &m) {
         if (err) *err = m;
@@ -25,12 +36,12 @@ bool makeCamera(const CameraSpec &s, Camera *cam, std::string *err) {
     if (s.width <= 0 || s.height <= 0) return fail("\"width\" and \"height\" must be at least 1");
 
     const Vec3 fwd = s.target - s.eye;
-    const double fl = length(fwd);
-    if (!(fl > 0)) return fail("\"eye\" equals \"target\"; the view has no direction");
-    const Vec3 f = fwd / fl;
-    const double ul = length(s.up);
-    if (!(ul > 0)) return fail("\"up\" has zero length; try [0, 1, 0]");
-    Vec3 r = cross(f, s.up / ul);
+    if (!isFinite(fwd))
+        return fail("\"target\" - \"eye\" overflows a double; bring the camera and its target closer together");
+    if (fwd == Vec3{0, 0, 0}) return fail("\"eye\" equals \"target\"; the view has no direction");
+    const Vec3 f = direction(fwd);
+    if (s.up == Vec3{0, 0, 0}) return fail("\"up\" has zero length; try [0, 1, 0]");
+    Vec3 r = cross(f, direction(s.up));
     const double rl = length(r);
     // |f x u| is the sine of their angle: below ~1e-9 the basis is numerically meaningless.
     if (!(rl > 1e-9)) return fail("\"up\" is parallel to the view direction; choose another up vector");
