@@ -565,7 +565,11 @@ bool preCheckPly(const std::string &path, const std::string &text, std::string *
                 return *err = at + "the PLY header holds a byte that is not text; is the header truncated?", false;
         if (line == 1) {
             if (w.size() != 1 || w[0] != "ply") return *err = path + ":1: expected 'ply', got '" + clip(l) + "'", false;
-        } else if (w.empty() || w[0] == "comment" || w[0] == "obj_info") {
+        } else if (w.empty() || w[0] == "comment") {
+        } else if (w[0] == "obj_info") {
+            // OpenMesh's header parser does not skip obj_info lines: it reads their words as keywords.
+            return *err = at + "obj_info lines are not supported (OpenMesh's reader misparses them); "
+                               "remove the line or make it a comment", false;
         } else if (w[0] == "end_header") {
             body = e + 1;
         } else if (w[0] == "format" && w.size() == 3 && format.empty() && w[2] == "1.0" &&

@@ -94,6 +94,18 @@ TEST(FuzzRegressions, PlyHeaderOpenMeshCannotParse) {
               "uchar short ushort int uint float double, or int8..float64), comment or end_header");
 }
 
+TEST(FuzzRegressions, PlyObjInfoLine) {
+    // fuzz_ply (hang in _PLYReader_::can_u_read): OpenMesh reads an obj_info line's words as header
+    // keywords ("element vertex binary_little_endia...").
+    EXPECT_EQ(loadError("objinfo.ply",
+                        "ply\nformat ascii 1.0\ncomment vzsaudit example: unit cube\nelement vertex 8\nproperty float x\n"
+                        "obj_info floaformat element vertex binary_little_endiaproperty list uchar int vertex_indicesex_indices\n"
+                        "end_header\n-0.5 -0.5 -0.5\n0.0.5 0.5 0.5\n4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n"
+                        "4 r 3 7 5\n"),
+              "P:6: obj_info lines are not supported (OpenMesh's reader misparses them); remove the line or make it a "
+              "comment");
+}
+
 TEST(FuzzRegressions, PlyCountsLargerThanTheFile) {
     // A list length of 2^32 - 1 with 8 bytes left, and rows without properties: refused before
     // OpenMesh's reader loops over them.
