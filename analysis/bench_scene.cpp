@@ -42,11 +42,12 @@ void appendSphere(RawMesh &m, Vec3 center, double radius, int S, int B) {
 
 }  // namespace
 
-RawMesh sphereGridMesh() {
+RawMesh sphereGridMesh() { return sphereGridMesh(kBenchSphereSegments, kBenchSphereBands); }
+
+RawMesh sphereGridMesh(int S, int B) {
     RawMesh m;
-    const int S = kBenchSphereSegments, B = kBenchSphereBands;
     m.positions.reserve(size_t(kBenchSphereGrid) * kBenchSphereGrid * (size_t((B - 1) * S) + 2) + 4);
-    m.indices.reserve(3 * kBenchSceneTriangles);
+    m.indices.reserve(3 * (size_t(kBenchSphereGrid) * kBenchSphereGrid * 2 * S * (B - 1) + 2));
     for (int i = 0; i < kBenchSphereGrid; ++i)
         for (int j = 0; j < kBenchSphereGrid; ++j)
             appendSphere(m, Vec3(kBenchSphereSpacing * i, 0, kBenchSphereSpacing * j), 1.0, S, B);

@@ -20,6 +20,9 @@ constexpr uint64_t kBenchSceneTriangles =
 
 // The geometry in world space (y up), spheres first (sphere (i, j) is number 10 i + j), ground last.
 RawMesh sphereGridMesh();
+// The same grid with each sphere tessellated in `segments` x `bands` (bench/'s scaling table):
+// 100 * 2 * segments * (bands - 1) + 2 triangles; segments >= 3, bands >= 2.
+RawMesh sphereGridMesh(int segments, int bands);
 
 // The view of the benchmark: eye (11.25, 13, -9) looking at (11.25, -1, 10.5), fov_y 55 degrees,
 // 1920 x 1080, near 0.5, far 200. Every triangle lies in front of the near plane.

@@ -9,6 +9,7 @@ PACKAGES=(
   libopenimageio-dev nlohmann-json3-dev libcli11-dev libtbb-dev
   libtinygltf-dev libstb-dev libzip-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libegl-dev libopengl-dev libgl1-mesa-dri
   parallel
   clang-14 libclang-rt-14-dev llvm-14
   chromium fonts-dejavu-core nodejs
