@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "analysis/limits.h"
 #include "analysis/load_bsp.h"
 #include "analysis/scene.h"
 
@@ -13,6 +14,8 @@ namespace va {
 struct LoadOptions {
     ChunkSettings chunks;
     BspOptions bsp;  // Quake 3 maps: patch tessellation level
+    uint64_t maxTriangles = kDefaultMaxTriangles;  // refused before allocating (--max-triangles;
+                                                   //   also caps bsp.maxTriangles)
 };
 
 // Loads any supported input: *.json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb.
@@ -23,7 +26,10 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err);
 
 // Reads a glTF 2.0 file: nodes become objects (world transforms applied), cameras become views,
 // doubleSided and alpha-blend materials become flags.
-bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err);
+// Accessor counts and the triangles all nodes instance are checked against maxTriangles before
+// anything is allocated for them.
+bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err,
+              uint64_t maxTriangles = kDefaultMaxTriangles);
 
 // Reads a views file: { "views": [ ... ] } with DESIGN.md's view keys.
 // Views without "up" get the file's top-level "up" axis if it has one, else the y axis.

@@ -426,7 +426,8 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         return fail("the map's drawn faces would make " + str(int64_t(drawnTriangles)) + " triangles and " +
                     str(int64_t(drawnVertices)) + " vertices at patch level " + str(L) + ", more than the limit of " +
                     str(int64_t(opt_.maxTriangles)) +
-                    " triangles; lower the patch level (--patch-level), or the file is damaged");
+                    " triangles; lower the patch level (--patch-level) or raise the limit with --max-triangles " +
+                    str(int64_t(drawnTriangles)) + ", or the file is damaged");
 
     // Models: float mins[3], maxs[3]; int face, n_faces, brush, n_brushes (40 bytes). Model 0 is the
     // world; the others are brush entities (doors, platforms, movers) stored where they rest.

@@ -59,8 +59,10 @@ double det3(const Mat4 &m) {
 
 // Reads accessor `index` as `count` elements of `comps` components each, converted to double
 // (normalized integers mapped to [0, 1] or [-1, 1] as the glTF spec says). Every byte read is
-// bounds-checked against its buffer view and buffer.
-bool readAccessor(const tinygltf::Model &model, int index, int comps, std::vector<double> *out, std::string *err) {
+// bounds-checked against its buffer view and buffer, and the count against maxElements, before the
+// output is allocated: a hostile count is refused, not trusted.
+bool readAccessor(const tinygltf::Model &model, int index, int comps, uint64_t maxElements, std::vector<double> *out,
+                  std::string *err) {
     if (index < 0 || size_t(index) >= model.accessors.size()) {
         *err = "accessor " + std::to_string(index) + " does not exist";
         return false;
@@ -81,8 +83,17 @@ bool readAccessor(const tinygltf::Model &model, int index, int comps, std::vecto
         *err = what + " has an unknown component type " + std::to_string(a.componentType);
         return false;
     }
-    out->assign(a.count * size_t(comps), 0.0);
-    if (a.bufferView < 0) return true;  // no buffer view: all zeros (glTF 2.0)
+    // Without a buffer view an accessor is all zeros (glTF 2.0): no byte of the file bounds its
+    // count, only the triangle limit does.
+    if (a.count > maxElements) {
+        *err = what + " has " + std::to_string(a.count) + " elements, more than the " + std::to_string(maxElements) +
+               " that the triangle limit allows (3 per triangle); raise it with --max-triangles, or the file is damaged";
+        return false;
+    }
+    if (a.bufferView < 0) {
+        out->assign(a.count * size_t(comps), 0.0);
+        return true;
+    }
     if (size_t(a.bufferView) >= model.bufferViews.size()) {
         *err = what + " refers to buffer view " + std::to_string(a.bufferView) + ", which does not exist";
         return false;
@@ -99,14 +110,20 @@ bool readAccessor(const tinygltf::Model &model, int index, int comps, std::vecto
         return false;
     }
     const size_t stride = size_t(strideInt), elem = size_t(csize) * size_t(comps);
-    if (a.count == 0) return true;
+    if (a.count == 0) {
+        out->clear();
+        return true;
+    }
     const size_t begin = bv.byteOffset + a.byteOffset;
-    const size_t need = a.byteOffset + stride * (a.count - 1) + elem;
-    if (need > bv.byteLength || bv.byteOffset + bv.byteLength > buf.size()) {
+    // need = byteOffset + stride (count - 1) + elem, compared without overflowing.
+    const bool fits = a.byteOffset <= bv.byteLength && elem <= bv.byteLength - a.byteOffset &&
+                      a.count - 1 <= (bv.byteLength - a.byteOffset - elem) / stride;
+    if (!fits || bv.byteOffset > buf.size() || bv.byteLength > buf.size() - bv.byteOffset) {
         *err = what + " reads past the end of its buffer view or buffer (" + std::to_string(a.count) +
                " elements); the file is truncated or inconsistent";
         return false;
     }
+    out->assign(a.count * size_t(comps), 0.0);
     const unsigned char *base = buf.data() + begin;
     for (size_t i = 0; i < a.count; ++i) {
         const unsigned char *p = base + i * stride;
@@ -139,6 +156,12 @@ struct GltfLoader {
     std::set<std::string> viewNames;
     uint64_t skippedPrimitives = 0;       // POINTS / LINES primitives
     uint64_t spotLights = 0;              // KHR_lights_punctual spot lights, read as point lights
+    uint64_t maxTriangles = kDefaultMaxTriangles;  // --max-triangles, over every node's instances
+    uint64_t triangles = 0;               // of the primitives added so far
+
+    // Accessor elements a primitive may need within the triangle limit: 3 per triangle (a strip or
+    // fan needs fewer).
+    uint64_t maxElements() const { return maxTriangles > (UINT64_MAX - 2) / 3 ? UINT64_MAX : 3 * maxTriangles + 2; }
 
     std::string nodeName(int i) const {
         const auto &n = model.nodes[size_t(i)];
@@ -203,9 +226,19 @@ struct GltfLoader {
             err = where + "has no POSITION attribute";
             return false;
         }
+        // The primitive's triangles from its accessors' declared counts, checked with every instance
+        // so far before anything is read: a small file may instance a large mesh many times.
+        const int countedAccessor = prim.indices >= 0 ? prim.indices : pos->second;
+        if (countedAccessor >= 0 && size_t(countedAccessor) < model.accessors.size()) {
+            const uint64_t n = model.accessors[size_t(countedAccessor)].count;
+            const uint64_t tris = mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;
+            triangles += std::min<uint64_t>(tris, UINT64_MAX - triangles);
+            if (!checkTriangleLimit(triangles, maxTriangles, where + "the scene up to this primitive", &err))
+                return false;
+        }
         std::vector<double> p, idx;
         std::string e;
-        if (!readAccessor(model, pos->second, 3, &p, &e)) {
+        if (!readAccessor(model, pos->second, 3, maxElements(), &p, &e)) {
             err = where + "POSITION " + e;
             return false;
         }
@@ -224,7 +257,7 @@ struct GltfLoader {
                 err = where + "indices must be unsigned byte, short or int";
                 return false;
             }
-            if (!readAccessor(model, prim.indices, 1, &idx, &e)) {
+            if (!readAccessor(model, prim.indices, 1, maxElements(), &idx, &e)) {
                 err = where + "indices " + e;
                 return false;
             }
@@ -429,7 +462,7 @@ struct GltfLoader {
 
 }  // namespace
 
-bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err) {
+bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err, uint64_t maxTriangles) {
     auto fail = [&](const std::string &m) {
         if (err) *err = m;
         return false;
@@ -464,7 +497,7 @@ bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err) {
     in.path = path;
     in.up = 'y';  // glTF is y-up
     if (!gwarn.empty()) in.warnings.push_back(path + ": tinygltf: " + oneLine(gwarn));
-    GltfLoader loader{path, model, &in, {}, {}, {}, 0, 0};
+    GltfLoader loader{path, model, &in, {}, {}, {}, 0, 0, maxTriangles, 0};
     if (!loader.run()) return fail(loader.err);
     *out = std::move(in);
     return true;

@@ -434,6 +434,8 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
     }
     const std::filesystem::path folder = std::filesystem::path(path).parent_path();
     std::map<std::string, RawMesh> meshCache;
+    uint64_t triangles = 0;  // of the objects so far: each object copies its mesh, so a small file
+                             //   instancing a large mesh many times is refused before the copies
     for (size_t i = 0; i < root["objects"].size(); ++i) {
         const Path p = op / i;
         const Json &j = root["objects"][i];
@@ -483,7 +485,8 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
         std::filesystem::path mp(o.mesh);
         const std::string file = (mp.is_absolute() ? mp : folder / mp).lexically_normal().string();
         auto cached = meshCache.find(file);
-        if (cached == meshCache.end()) {
+        const bool firstUse = cached == meshCache.end();
+        if (firstUse) {
             RawMesh m;
             std::string e;
             if (!loadMeshFile(file, &m, &e)) {
@@ -492,11 +495,13 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
                 return false;
             }
             cached = meshCache.emplace(file, std::move(m)).first;
-            o.geometry = cached->second;
-        } else {
-            o.geometry = cached->second;
-            o.geometry.warnings.clear();  // reported once, with the first object using the mesh
         }
+        triangles += cached->second.indices.size() / 3;
+        if (!checkTriangleLimit(triangles, opt.maxTriangles,
+                                json::where(doc, p) + ": the scene up to object '" + o.name + "'", err))
+            return false;
+        o.geometry = cached->second;
+        if (!firstUse) o.geometry.warnings.clear();  // reported once, with the first object using the mesh
         const Mat4 worldFromObject = Mat4::translate(t) * Mat4::rotateXYZDegrees(rot) * Mat4::scale(s);
         for (auto &v : o.geometry.positions) v = transformPoint(worldFromObject, v);
         // The mesh's own coordinates are finite (loadMeshFile refuses others): a non-finite one now
@@ -627,7 +632,11 @@ bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::str
 
 bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
     // Quake 3 maps: "x.bsp", or a member of a .pk3 archive, "pak.pk3:maps/x.bsp" (analysis/load_bsp.h).
-    if (isBspPath(path)) return loadBspScene(path, opt.bsp, opt.chunks, out, err);
+    if (isBspPath(path)) {
+        BspOptions bsp = opt.bsp;
+        bsp.maxTriangles = opt.maxTriangles;
+        return loadBspScene(path, bsp, opt.chunks, out, err);
+    }
     const std::string ext = lowerExt(path);
     if (ext == ".json") {
         // Every expected failure returns false; this only turns a library exception we did not
@@ -645,10 +654,11 @@ bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std:
         o.name = std::filesystem::path(path).stem().string();
         o.mesh = path;
         if (!loadMeshFile(path, &o.geometry, err)) return false;
+        if (!checkTriangleLimit(o.geometry.indices.size() / 3, opt.maxTriangles, path, err)) return false;
         in.objects.push_back(std::move(o));
         in.path = path;
     } else if (ext == ".gltf" || ext == ".glb") {
-        if (!loadGltf(path, &in, err)) return false;
+        if (!loadGltf(path, &in, err, opt.maxTriangles)) return false;
     } else {
         *err = path + ": unsupported input '" + ext +
                "'; supported: .json (visaudit-scene/1), .obj .ply .off .stl (one mesh), .gltf .glb (glTF 2.0)";

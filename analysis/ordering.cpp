@@ -385,7 +385,7 @@ BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, 
     return r;
 }
 
-ABufferResult abufferForView(const OrderingView &v) {
+ABufferResult abufferForView(const OrderingView &v, uint32_t maxListLength) {
     const Scene &scene = *v.scene;
     const size_t n = scene.triangleCount();
     std::vector<float> alpha(n, 1.0f);
@@ -409,7 +409,7 @@ ABufferResult abufferForView(const OrderingView &v) {
     m.singleSided = v.singleSided.data();
     m.surface = surface.data();
     m.background[0] = m.background[1] = m.background[2] = 24;
-    return resolveABuffer(v.all, v.cam.width, v.cam.height, v.cam.orthographic, m);
+    return resolveABuffer(v.all, v.cam.width, v.cam.height, v.cam.orthographic, m, maxListLength);
 }
 
 OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const ReferenceVisibility &ref,
@@ -497,7 +497,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
 
     r.abufferReason = abuffer.reason;
     if (abuffer.run) {
-        r.abuffer = abufferForView(v);
+        r.abuffer = abufferForView(v, settings.abufferMaxList);
         r.abufferRan = true;
     }
     r.ms = msSince(t0);

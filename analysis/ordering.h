@@ -179,6 +179,7 @@ struct OrderingRow {
 struct OrderingSettings {
     PainterKey painterKey = PainterKey::centroid;
     bool overlapTests = true;      // the painter's pair tests (costs a tile sweep)
+    uint32_t abufferMaxList = kABufferDefaultMaxList;  // longest A-buffer list (--max-abuffer-list)
 };
 
 struct OrderingResult {
@@ -201,6 +202,6 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
 
 // The A-buffer's per-source-triangle inputs from the scene: material alpha, a color per source
 // object (a fixed hash of its index), single-sided flags.
-ABufferResult abufferForView(const OrderingView &v);
+ABufferResult abufferForView(const OrderingView &v, uint32_t maxListLength = kABufferDefaultMaxList);
 
 }  // namespace va

@@ -1,10 +1,12 @@
 #include "analysis/pipeline.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
 
 #include <tbb/global_control.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
 #include "analysis/backface.h"
@@ -97,6 +99,8 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     ViewResult r;
     r.spec = view;
     r.camera = cam;
+    // Checked between stages: an interrupted view returns what it has, and analyzeScene discards it.
+    auto stopped = [&] { return s.cancel && s.cancel->load(std::memory_order_relaxed) != 0; };
 
     std::vector<uint32_t> objects(scene.objects.size());  // the objects still in, ascending
     for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
@@ -212,6 +216,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         }
     }
 
+    if (stopped()) return r;
     // Backface: plane at the eye, per triangle.
     TriangleLists lists;
     {
@@ -262,6 +267,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         r.stages.push_back(st);
     }
 
+    if (stopped()) return r;
     // Z-buffer: rasterize in the view's depth format.
     std::vector<uint32_t> fragmentsPerSource;  // per source triangle (audit: wasted fragments)
     {
@@ -289,6 +295,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // Raycast: Embree primary rays over the whole scene with no culling (single-sided triangles seen
     // from their front only, as the reference sees them; ties to the lowest id), compared pixel by
     // pixel with the z-buffer; then the secondary rays the effects plan calls for.
+    if (stopped()) return r;
     if (ps.rays) {
         StageRecord st;
         st.name = "raycast";
@@ -315,7 +322,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         r.stages.push_back(st);
         r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, r.raycastImage.id, r.raycastImage.depth, scene, cam,
                                   makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ), ps.rays->origin());
-        if (ps.effects.tracesRays()) {
+        if (ps.effects.tracesRays() && !stopped()) {
             r.effects = traceEffects(*ps.rays, cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
             r.effectsRan = true;
         }
@@ -325,6 +332,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
 
     // Audit: the reference visibility (no culling at all), and what each culling stage removed
     // that is in fact visible (false culls) or kept that is visible nowhere (wasted draws).
+    if (stopped()) return r;
     if (s.audit) {
         const auto t0 = Clock::now();
         r.reference = referenceVisibility(scene, cam);
@@ -337,14 +345,18 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
 
     // Audit: draw orders against the reference -- painter's, BSP, scanline, overdraw by order, and
     // the A-buffer where the scene has transparency.
+    if (stopped()) return r;
     if (ps.bspTree && r.auditRan) {
-        r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer, s.orderingSettings);
+        OrderingSettings os = s.orderingSettings;
+        os.abufferMaxList = s.limits.maxABufferList;
+        r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer, os);
         r.orderingRan = true;
     } else {
         r.orderingReason = ps.orderingReason.empty() ? "needs the reference visibility" : ps.orderingReason;
     }
 
     // Audit: detail -- triangles drawn against the pixels they show, too small, over-detailed.
+    if (stopped()) return r;
     if (s.detail) {
         r.detail = auditDetail(scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
         r.detailRan = true;
@@ -352,6 +364,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
 
     // Audit: z-fighting of the two nearest surfaces per pixel, in every depth format, over exactly
     // the triangles the z-buffer drew.
+    if (stopped()) return r;
     if (s.zfight) {
         const auto t0 = Clock::now();
         r.zfight = analyzeZFighting(scene, cam, clip.out, s.zfightSettings);
@@ -364,14 +377,118 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     return r;
 }
 
+MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cams, const PipelineSettings &s) {
+    // Terms of the form "bytes per pixel" and "bytes per triangle" add up the buffers a stage keeps
+    // (their element sizes), plus the temporaries alive next to them at the stage's peak. The
+    // constants were checked against peak RSS (docs/limits.md, "Memory"); the estimate is meant to
+    // err high, since an estimate that errs low lets the kernel's OOM killer end the run unreported.
+    MemoryEstimate m;
+    auto bytesOf = [](const auto &v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
+    const uint64_t tris = scene.triangleCount();
+    m.scene = bytesOf(scene.positions) + bytesOf(scene.indices) + bytesOf(scene.triangleObject) +
+              bytesOf(scene.objectTriangles) + bytesOf(scene.planes) +
+              uint64_t(scene.objects.size()) * (sizeof(SceneObject) + 32) +
+              uint64_t(scene.sources.size()) * (sizeof(SourceObject) + 64);
+    if (scene.bsp) m.scene += bytesOf(scene.bsp->pvs) + bytesOf(scene.bsp->leafFaces) + bytesOf(scene.bsp->nodes) +
+                              bytesOf(scene.bsp->leafs) + bytesOf(scene.bsp->planes);
+
+    // Built once: the object BVH and grid (per object), Embree's float copy and BVH (about 100
+    // bytes per triangle with the build's temporaries), per-triangle effect data, the ordering
+    // audit's BSP tree (its splits are bounded by orderingMaxTriangles; a few pieces per triangle).
+    const uint64_t objects = scene.objects.size();
+    m.prepared = objects * 256;
+    if (s.raycast) m.prepared += tris * 112 + uint64_t(scene.positions.size()) * 12;
+    if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) m.prepared += tris * 400;
+
+    // Per view, per pixel. Kept in ViewResult until onView has written the images:
+    //   z-buffer key, id, depth, fragments, passes        4 + 4 + 8 + 2 + 2 = 20
+    //   reference id, depth; culling fate                  4 + 8 + 1 = 13
+    //   raycast id, depth (+ u, v with effects); disagreements   8 (+ 8) + 1
+    //   z-fighting: class, fight mask, hotspot ids (+ 2 nearest depths and triangles while it runs)
+    //                                                      9 + 24
+    //   ordering: painter and BSP id + class, scanline id, per-order overdraw, A-buffer composite,
+    //     edges, heads, lengths and center depth          5 + 5 + 4 + 8 + 4 + 24
+    //   occlusion's pre-pass depth and Hi-Z pyramid (freed before the z-buffer)   not added
+    //   writing images (one 8-bit RGBA or float image at a time, and the PNG encoder)   16
+    uint64_t perPixel = 20 + 16;
+    if (s.audit) perPixel += 13;
+    if (s.raycast) perPixel += 9;
+    if (s.zfight) perPixel += 33;
+    const EffectPlan plan = planEffects(scene, s.effects);
+    if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;
+    if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) {
+        perPixel += 22;
+        // The A-buffer's fragments: a level's depth complexity is a few layers; the pool itself is
+        // counted before it is allocated (--max-abuffer-list), 20 bytes a fragment.
+        if (plan.abuffer.run) perPixel += 36 + 4 * sizeof(ABufferFragment);
+    }
+    // Per view, per triangle (any triangle may be in view): fragments per source, the raycast's
+    // seen flags, the audit's pixels per source, the backface lists, the clipped screen triangles
+    // (fixed-point corners, source, plane) and depth planes, the ordering's screen ranges.
+    uint64_t perTriangle = 4 + 8 + 6 * 4 + 4 + 4 + sizeof(DepthPlane);
+    if (s.audit) perTriangle += 4 + 8;
+    if (s.raycast) perTriangle += 1;
+    if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) perTriangle += 8 + 1 + 12;
+    uint64_t pixels = 0;
+    for (const Camera &c : cams) pixels = std::max(pixels, uint64_t(c.width) * uint64_t(c.height));
+    m.perView = pixels * perPixel + tris * perTriangle;
+
+    const uint64_t threads = s.threads > 0 ? uint64_t(s.threads) : uint64_t(tbb::info::default_concurrency());
+    m.viewsInFlight = std::min<uint64_t>(threads, cams.size());
+    constexpr uint64_t kBaseline = 128ull << 20;  // the program, its libraries, TBB's and Embree's pools
+    // What a finished view's result keeps once its images are written (statistics, hotspot and
+    // offender lists, stage records): the report needs it.
+    constexpr uint64_t kPerFinishedView = 64ull << 10;
+    m.total = kBaseline + m.scene + m.prepared + m.perView * m.viewsInFlight + kPerFinishedView * cams.size();
+    return m;
+}
+
+namespace {
+// Every limit of docs/limits.md that can be checked before work starts (resolution is checked per
+// view by resolveView; triangles by the loaders; the A-buffer's lists by the A-buffer itself).
+bool checkLimits(const Scene &scene, const std::vector<Camera> &cams, const PipelineSettings &s, std::string *err) {
+    const EffectPlan plan = planEffects(scene, s.effects);
+    if (s.raycast && (plan.reflections.run || plan.refractions.run) && s.effects.maxDepth > s.limits.maxRecursion) {
+        // With a refractive surface every hit spawns a reflection and a refraction: 2^(d+1) - 2
+        // secondary rays per pixel at depth d.
+        *err = "--max-depth " + std::to_string(s.effects.maxDepth) + " needs a recursion depth of " +
+               std::to_string(s.effects.maxDepth) + ", more than the limit of " + std::to_string(s.limits.maxRecursion) +
+               (plan.refractions.run ? " (with refraction a pixel may trace 2^" + std::to_string(s.effects.maxDepth + 1) +
+                                           " - 2 secondary rays)"
+                                     : std::string()) +
+               "; lower --max-depth or raise the limit with --max-recursion " + std::to_string(s.effects.maxDepth);
+        return false;
+    }
+    if (s.limits.maxMemory > 0) {
+        const MemoryEstimate m = estimateMemory(scene, cams, s);
+        if (m.total > s.limits.maxMemory) {
+            *err = "the analysis needs about " + formatBytes(m.total) + " of memory (scene " + formatBytes(m.scene) +
+                   ", acceleration structures " + formatBytes(m.prepared) + ", " + std::to_string(m.viewsInFlight) +
+                   " view(s) at once of " + formatBytes(m.perView) + " each), more than the limit of " +
+                   formatBytes(s.limits.maxMemory) + "; lower the resolution (--width/--height) or --threads, or "
+                   "raise the limit with --max-memory " + std::to_string((m.total + (1 << 20) - 1) >> 20) + "M";
+            return false;
+        }
+    }
+    return true;
+}
+}  // namespace
+
 bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const PipelineSettings &s,
                   const std::function<bool(size_t index, ViewResult &, std::string *)> &onView, AnalysisResult *out,
                   std::string *err) {
-    // Validate every view before any work, so bad input never leaves a partial report.
+    auto stopped = [&] { return s.cancel && s.cancel->load(std::memory_order_relaxed) != 0; };
+    // Validate every view and the limits before any work, so bad input never leaves a partial
+    // report and a run the machine cannot hold is refused before it allocates.
     std::vector<ViewSpec> resolved(views.size());
     std::vector<Camera> cams(views.size());
     for (size_t i = 0; i < views.size(); ++i)
         if (!resolveView(views[i], s, &resolved[i], &cams[i], err)) return false;
+    if (!checkLimits(scene, cams, s, err)) return false;
+    if (stopped()) {
+        *err = kInterrupted;
+        return false;
+    }
 
     out->scenePath = scene.path;
     out->sceneStats = scene.stats;
@@ -385,6 +502,10 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
     if (s.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(s.threads));
     PreparedScene ps;
     if (!prepareScene(scene, s, &ps, err)) return false;
+    if (stopped()) {
+        *err = kInterrupted;
+        return false;
+    }
     out->effects = ps.effects;
     out->raycast = ps.rays != nullptr;
     out->raySceneBuildMs = ps.raySceneBuildMs;
@@ -407,20 +528,20 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
     std::mutex errMutex;
     std::string firstErr;
     std::atomic<bool> failed{false};
+    auto failWith = [&](const std::string &e) {
+        std::lock_guard<std::mutex> lock(errMutex);
+        if (!failed.exchange(true)) firstErr = e;
+    };
     tbb::parallel_for(size_t(0), views.size(), [&](size_t i) {
         if (failed) return;
+        if (stopped()) return failWith(kInterrupted);
         ViewResult v = analyzeView(ps, resolved[i], cams[i], s);
+        if (stopped()) return failWith(kInterrupted);
         std::string e;
-        if (v.effectsRan && !v.effects.ok) {
-            std::lock_guard<std::mutex> lock(errMutex);
-            if (!failed.exchange(true)) firstErr = "view '" + v.spec.name + "': effects: " + v.effects.error;
-            return;
-        }
-        if (onView && !onView(i, v, &e)) {
-            std::lock_guard<std::mutex> lock(errMutex);
-            if (!failed.exchange(true)) firstErr = e;
-            return;
-        }
+        if (v.effectsRan && !v.effects.ok) return failWith("view '" + v.spec.name + "': effects: " + v.effects.error);
+        if (v.orderingRan && !v.ordering.abuffer.error.empty())
+            return failWith("view '" + v.spec.name + "': " + v.ordering.abuffer.error);
+        if (onView && !onView(i, v, &e)) return failWith(e);
         out->views[i] = std::move(v);
     });
     if (failed) {

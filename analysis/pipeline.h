@@ -2,6 +2,7 @@
 // glue that turns the scene model into the plain data render/ works on.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -14,6 +15,7 @@
 #include "analysis/zfight.h"
 #include "analysis/detail.h"
 #include "analysis/grid.h"
+#include "analysis/limits.h"
 #include "analysis/occlusion.h"
 #include "analysis/bsp_tree.h"
 #include "analysis/ordering.h"
@@ -23,11 +25,6 @@
 #include "render/clip.h"
 
 namespace va {
-
-// Hard limits that protect the machine from absurd input; refused before allocating.
-struct Limits {
-    int maxResolution = 16384;  // per side
-};
 
 struct PipelineSettings {
     bool cells = true;     // --no-cells turns the stage off (where the scene has cells or a PVS)
@@ -52,9 +49,26 @@ struct PipelineSettings {
     bool raycast = true;   // --no-raycast turns the raycast stage (and the effects) off
     EffectFlags effects;   // --shadows/--no-shadows, ..., --max-depth
     ZFightSettings zfightSettings;
-    Limits limits;
+    Limits limits;                             // refused before allocating (docs/limits.md)
     int threads = 0;                           // 0: all cores
+    // Not null: analyzeScene stops between views and stages once it holds a nonzero value (the CLI's
+    // SIGINT/SIGTERM handler stores the signal number) and returns false with kInterrupted.
+    const std::atomic<int> *cancel = nullptr;
 };
+
+// analyzeScene's *err when settings.cancel stopped it.
+inline constexpr const char *kInterrupted = "interrupted";
+
+// What a run needs at its peak, estimated from the scene and the resolved views before anything
+// is built (docs/limits.md has the terms and their measured error).
+struct MemoryEstimate {
+    uint64_t scene = 0;     // the loaded scene model (its arrays, as allocated)
+    uint64_t prepared = 0;  // built once per scene: Embree's BVH, the object BVH and grid, the BSP tree
+    uint64_t perView = 0;   // the largest view's buffers (per pixel and per triangle)
+    uint64_t viewsInFlight = 0;  // views analysed at once (threads, at most the number of views)
+    uint64_t total = 0;     // baseline + scene + prepared + perView * viewsInFlight + finished views' results
+};
+MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cams, const PipelineSettings &s);
 
 // View-independent acceleration data, built once per scene.
 struct PreparedScene {

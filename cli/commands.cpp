@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -23,6 +24,7 @@
 #include "analysis/demo.h"
 #include "analysis/depth_audit.h"
 #include "analysis/level_views.h"
+#include "analysis/limits.h"
 #include "analysis/load.h"
 #include "analysis/pipeline.h"
 #include "reports/console.h"
@@ -45,7 +47,12 @@ struct Options {
     std::string depthFormat;
     int width = 0, height = 0;
     int threads = 0;
-    int maxResolution = 16384;
+    // Resource limits (docs/limits.md)
+    int maxResolution = kDefaultMaxResolution;
+    uint64_t maxTriangles = kDefaultMaxTriangles;
+    int maxRecursion = kDefaultMaxRecursion;
+    uint32_t maxABufferList = kDefaultMaxABufferList;
+    std::string maxMemory;  // empty: defaultMaxMemory()
     uint32_t chunk = 512;
     bool noBackface = false, noFrustum = false, noZFight = false, noAudit = false, noCells = false, noRaycast = false;
     int patchLevel = 5;
@@ -75,6 +82,47 @@ struct Options {
 
 void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
 
+// SIGINT and SIGTERM: the handler only records the signal; the pipeline polls it between views
+// and stages (PipelineSettings::cancel) and the commands before they write, so a stopped run
+// leaves no half-written report and the old output folder as it was (docs/limits.md).
+std::atomic<int> gInterrupt{0};
+static_assert(std::atomic<int>::is_always_lock_free, "a signal handler may only touch lock-free atomics");
+
+void onInterruptSignal(int sig) { gInterrupt.store(sig, std::memory_order_relaxed); }
+
+void installInterruptHandlers() {
+    struct sigaction sa = {};
+    sa.sa_handler = onInterruptSignal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;  // blocking calls resume; the flag is polled, not an EINTR
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+bool interrupted() { return gInterrupt.load(std::memory_order_relaxed) != 0; }
+
+// The one line and the exit code (128 + signal, as a shell reports a signal) of a stopped run.
+int interruptedExit(const std::string &out) {
+    const int sig = gInterrupt.load(std::memory_order_relaxed);
+    std::fprintf(stderr, "visaudit: interrupted by %s; nothing was written%s\n", sig == SIGINT ? "SIGINT" : "SIGTERM",
+                 out.empty() ? "" : ("; '" + out + "' is as it was").c_str());
+    return 128 + sig;
+}
+
+// --max-memory, or the default (a fraction of the machine's memory).
+bool memoryLimit(const Options &o, uint64_t *bytes) {
+    if (o.maxMemory.empty()) {
+        *bytes = defaultMaxMemory();
+        return true;
+    }
+    std::string err;
+    if (!parseByteSize(o.maxMemory, bytes, &err)) {
+        fail("--max-memory: " + err);
+        return false;
+    }
+    return true;
+}
+
 // Loads the scene (or makes the demo) and its views as the options say.
 bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
     std::string err;
@@ -84,6 +132,7 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
         LoadOptions lo;
         lo.chunks.maxTriangles = o.chunk;
         lo.bsp.patchLevel = o.patchLevel;
+        lo.maxTriangles = o.maxTriangles;
         if (!loadScene(o.scene, lo, scene, &err)) {
             fail(err);
             return false;
@@ -154,6 +203,10 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->height = o.height;
     s->threads = o.threads;
     s->limits.maxResolution = o.maxResolution;
+    s->limits.maxRecursion = o.maxRecursion;
+    s->limits.maxABufferList = o.maxABufferList;
+    if (!memoryLimit(o, &s->limits.maxMemory)) return false;
+    s->cancel = &gInterrupt;
     if (!o.depthFormat.empty()) {
         DepthFormat f;
         std::string err;
@@ -206,11 +259,13 @@ int analyzeToReport(const Options &o,
                     nlohmann::ordered_json *report) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
+    installInterruptHandlers();
     PipelineSettings settings;
     if (!makeSettings(o, &settings)) return kExitBadInput;
     Scene scene;
     std::vector<ViewSpec> views;
     if (!loadInputs(o, &scene, &views)) return kExitBadInput;
+    if (interrupted()) return interruptedExit(o.out);
     const double loadMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 
     std::string err;
@@ -269,6 +324,11 @@ int analyzeToReport(const Options &o,
         v.zfight.pixelClass = {};
         v.zfight.fightMask = {};
         v.zfight.hotspotOf = {};
+        v.raycastImage = RaycastImage{};
+        v.crossCheck.cls = {};
+        v.effects.shadowMask = {};
+        v.effects.secondaryDepth = {};
+        v.effects.secondaryRays = {};
         const int k = ++done;
         if (!o.quiet) {
             // A terminal gets one line rewritten in place with an estimate of the time left; a log
@@ -286,6 +346,8 @@ int analyzeToReport(const Options &o,
     };
     if (!analyzeScene(scene, views, settings, onView, &result, &err)) {
         if (tty && !o.quiet) std::fprintf(stderr, "\n");
+        // out's destructor removes the staging folder; the target was never touched.
+        if (interrupted()) return interruptedExit(o.out);
         fail(err);
         return kExitBadInput;
     }
@@ -293,9 +355,16 @@ int analyzeToReport(const Options &o,
     result.loadMs = loadMs;
     *report = reportJson(result);
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
-    // with the path, and the previous report stays as it was.
+    // with the path, and the previous report stays as it was. A signal is honoured up to the
+    // commit; the swap itself is not interrupted (the handler only sets a flag), and a run whose
+    // report is in place has finished.
     if (!writeFileAtomic(out.staging() + "/report.json", report->dump(2) + "\n", &err) ||
-        !writeReportHtml(*report, out.staging(), &err) || !out.commit(&err)) {
+        !writeReportHtml(*report, out.staging(), &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (interrupted()) return interruptedExit(o.out);
+    if (!out.commit(&err)) {
         fail(err);
         return kExitBadInput;
     }
@@ -423,6 +492,7 @@ void addGradeOptions(CLI::App *c, Options &o) {
 }
 
 int cmdMerge(const Options &o) {
+    installInterruptHandlers();
     std::string err;
     OutputDir out;
     if (!out.open(o.out, &err)) {
@@ -435,7 +505,12 @@ int cmdMerge(const Options &o) {
         return kExitBadInput;
     }
     if (!writeFileAtomic(out.staging() + "/report.json", merged.dump(2) + "\n", &err) ||
-        !writeReportHtml(merged, out.staging(), &err) || !out.commit(&err)) {
+        !writeReportHtml(merged, out.staging(), &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (interrupted()) return interruptedExit(o.out);
+    if (!out.commit(&err)) {
         fail(err);
         return kExitBadInput;
     }
@@ -457,6 +532,7 @@ void addMergeOptions(CLI::App *c, Options &o) {
 int depthAuditScene(const Options &o, const std::vector<DepthFormat> &formats) {
     Options lo = o;
     lo.scene = o.auditScene;
+    installInterruptHandlers();
     Scene scene;
     std::vector<ViewSpec> views;
     if (!loadInputs(lo, &scene, &views)) return kExitBadInput;
@@ -464,9 +540,12 @@ int depthAuditScene(const Options &o, const std::vector<DepthFormat> &formats) {
     s.audit = s.raycast = s.detail = s.occlusion = false;
     s.zfightSettings.formats = formats;
     s.threads = o.threads;
+    s.limits.maxMemory = defaultMaxMemory();
+    s.cancel = &gInterrupt;
     AnalysisResult result;
     std::string err;
     if (!analyzeScene(scene, views, s, nullptr, &result, &err)) {
+        if (interrupted()) return interruptedExit("");
         fail(err);
         return kExitBadInput;
     }
@@ -562,6 +641,9 @@ void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("--patch-level", o.patchLevel, "Quake 3 maps: segments per Bezier patch edge")->check(CLI::Range(1, 64));
     c->add_option("--chunk", o.chunk, "Split meshes into culling objects of at most this many triangles")
         ->check(CLI::Range(1u, 1u << 30));
+    c->add_option("--max-triangles", o.maxTriangles,
+                  "Largest scene accepted, in triangles (default 100000000; at most 4294967295, the 32-bit ids)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
 }
 
 void addAnalyzeOptions(CLI::App *c, Options &o) {
@@ -571,8 +653,17 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_option("--height", o.height, "Override every view's height in pixels")->check(CLI::Range(1, 1 << 30));
     c->add_option("--depth-format", o.depthFormat, "Override every view's depth format (e.g. f32, unorm24)");
     c->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
-    c->add_option("--max-resolution", o.maxResolution, "Largest width or height accepted")
+    c->add_option("--max-resolution", o.maxResolution, "Largest width or height accepted (default 16384)")
         ->check(CLI::Range(1, 1 << 20));
+    c->add_option("--max-recursion", o.maxRecursion,
+                  "Deepest --max-depth accepted when reflection or refraction rays are traced (default 16; "
+                  "at most 255)")
+        ->check(CLI::Range(0, 255));
+    c->add_option("--max-abuffer-list", o.maxABufferList, "Most fragments in one pixel's A-buffer list (default 1024)")
+        ->check(CLI::Range(1u, UINT32_MAX - 1));
+    c->add_option("--max-memory", o.maxMemory,
+                  "Most memory the analysis may need at its peak, estimated before it starts: bytes or K/M/G/T "
+                  "(default three quarters of the RAM or the container's limit; 0 = no check)");
     c->add_flag("--no-backface", o.noBackface, "Turn the backface stage off");
     c->add_flag("--no-frustum", o.noFrustum, "Turn the frustum stage off");
     c->add_flag("--no-zfight", o.noZFight, "Turn the z-fighting analysis off");

@@ -20,7 +20,7 @@ constexpr uint32_t kEnd = std::numeric_limits<uint32_t>::max();
 const SampleOffset *abufferSampleOffsets() { return kGrid; }
 
 ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height, bool orthographic,
-                             const ABufferMaterials &mat) {
+                             const ABufferMaterials &mat, uint32_t maxListLength) {
     const auto t0 = std::chrono::steady_clock::now();
     ABufferResult r;
     r.width = std::max(width, 0);
@@ -33,41 +33,72 @@ ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height,
     for (int i = 0; i < kABufferSamples; ++i) offsets[i] = kGrid[i];
     offsets[kABufferSamples] = kCenterSample;
     constexpr uint32_t kCenterBit = 1u << kABufferSamples;
+    // fn(triangle, source, pixel, mask) for every pixel a drawn triangle covers at a sample.
+    auto forEachCoverage = [&](auto &&fn) {
+        for (size_t t = 0; t < tris.size(); ++t) {
+            const uint32_t src = tris.source[t];
+            if (!tris.planes[tris.plane[t]].valid) continue;
+            bool front = false;
+            coverageMasks(tris, t, r.width, r.height, offsets, kABufferSamples + 1, &front, [&](size_t p, uint32_t mask) {
+                if (mat.singleSided && mat.singleSided[src] && !front) return;
+                fn(t, src, p, mask);
+            });
+        }
+    };
 
-    // Build: a fragment pool with per-pixel singly linked lists (head per pixel), as Carpenter's.
-    std::vector<uint32_t> head(pixels, kEnd);
-    std::vector<ABufferFragment> pool;
-    // The z-buffer's view for the comparison (not part of the A-buffer's memory): the nearest
-    // triangle covering each pixel center, depth at the center, ties to the lowest source.
+    // Pass 1: each pixel's list length, so a hostile pile of layers is refused before the pool is
+    // allocated; and the z-buffer's view for the comparison (not part of the A-buffer's memory): the
+    // nearest triangle covering each pixel center, depth at the center, ties to the lowest source.
+    std::vector<uint32_t> length(pixels, 0);
     std::vector<uint32_t> centerId(pixels, 0);
     std::vector<double> centerD(pixels, std::numeric_limits<double>::infinity());
-    for (size_t t = 0; t < tris.size(); ++t) {
-        const uint32_t src = tris.source[t];
-        const DepthPlane &pl = tris.planes[tris.plane[t]];
-        if (!pl.valid) continue;
-        bool front = false;
-        coverageMasks(tris, t, r.width, r.height, offsets, kABufferSamples + 1, &front, [&](size_t p, uint32_t mask) {
-            if (mat.singleSided && mat.singleSided[src] && !front) return;
-            if (mask & kCenterBit) {
-                const double v = evalDepthPlane(pl, double(p % size_t(r.width)) + 0.5, double(p / size_t(r.width)) + 0.5);
-                const double d = orthographic ? v : 1.0 / v;
-                if (d < centerD[p] || (d == centerD[p] && src + 1 < centerId[p])) {
-                    centerD[p] = d;
-                    centerId[p] = src + 1;
-                }
+    uint64_t total = 0;
+    size_t longest = 0;  // a pixel with the longest list
+    forEachCoverage([&](size_t t, uint32_t src, size_t p, uint32_t mask) {
+        if (mask & kCenterBit) {
+            const DepthPlane &pl = tris.planes[tris.plane[t]];
+            const double v = evalDepthPlane(pl, double(p % size_t(r.width)) + 0.5, double(p / size_t(r.width)) + 0.5);
+            const double d = orthographic ? v : 1.0 / v;
+            if (d < centerD[p] || (d == centerD[p] && src + 1 < centerId[p])) {
+                centerD[p] = d;
+                centerId[p] = src + 1;
             }
-            if ((mask & 0xFFFF) == 0) return;  // only the center: no sub-sample, no A-buffer fragment
-            ABufferFragment f;
-            f.source = src;
-            f.plane = tris.plane[t];
-            f.mask = uint16_t(mask & 0xFFFF);
-            f.alpha = mat.alpha ? mat.alpha[src] : 1.0f;
-            f.next = head[p];
-            head[p] = uint32_t(pool.size());
-            pool.push_back(f);
-            if (f.alpha < 1) ++r.transparentFragments;
-        });
+        }
+        if ((mask & 0xFFFF) == 0) return;  // only the center: no sub-sample, no A-buffer fragment
+        if (length[p] != UINT32_MAX) ++length[p];  // saturates: it is refused anyway
+        if (length[p] > length[longest]) longest = p;
+        ++total;
+    });
+    if (pixels && length[longest] > maxListLength) {
+        r.error = "A-buffer: pixel (" + std::to_string(longest % size_t(r.width)) + ", " +
+                  std::to_string(longest / size_t(r.width)) + ") needs a list of " + std::to_string(length[longest]) +
+                  " fragments, more than the limit of " + std::to_string(maxListLength) +
+                  "; raise it with --max-abuffer-list " + std::to_string(length[longest]) +
+                  " (or turn the A-buffer off with --no-abuffer)";
+        return r;
     }
+    if (total >= kEnd) {  // list links are 32-bit; kEnd ends a list
+        r.error = "A-buffer: " + std::to_string(total) + " fragments, more than its 32-bit lists hold (" +
+                  std::to_string(kEnd - 1) + "); lower the resolution or turn the A-buffer off with --no-abuffer";
+        return r;
+    }
+
+    // Pass 2: a fragment pool with per-pixel singly linked lists (head per pixel), as Carpenter's.
+    std::vector<uint32_t> head(pixels, kEnd);
+    std::vector<ABufferFragment> pool;
+    pool.reserve(size_t(total));
+    forEachCoverage([&](size_t t, uint32_t src, size_t p, uint32_t mask) {
+        if ((mask & 0xFFFF) == 0) return;
+        ABufferFragment f;
+        f.source = src;
+        f.plane = tris.plane[t];
+        f.mask = uint16_t(mask & 0xFFFF);
+        f.alpha = mat.alpha ? mat.alpha[src] : 1.0f;
+        f.next = head[p];
+        head[p] = uint32_t(pool.size());
+        pool.push_back(f);
+        if (f.alpha < 1) ++r.transparentFragments;
+    });
     r.fragments = pool.size();
     r.memoryBytes = pool.size() * sizeof(ABufferFragment) + pixels * sizeof(uint32_t);
     r.listHistogram.assign(kABufferHistogramMax, 0);
@@ -89,8 +120,7 @@ ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height,
     std::vector<Entry> list;
     for (size_t p = 0; p < pixels; ++p) {
         const size_t x = p % size_t(r.width), y = p / size_t(r.width);
-        uint32_t len = 0;
-        for (uint32_t f = head[p]; f != kEnd; f = pool[f].next) ++len;
+        const uint32_t len = length[p];
         ++r.listHistogram[std::min<size_t>(len, kABufferHistogramMax - 1)];
         uint8_t *out = &r.rgb[3 * p];
         if (len == 0) {

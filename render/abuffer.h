@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -60,8 +61,14 @@ struct ABufferFragment {
 };
 
 constexpr size_t kABufferHistogramMax = 64;  // list lengths >= this share the last bucket
+// The longest list accepted by default (--max-abuffer-list; docs/limits.md): a level's depth
+// complexity is tens; a thousand stacked transparent layers in one pixel is a bug or hostile input.
+constexpr uint32_t kABufferDefaultMaxList = 1024;
 
 struct ABufferResult {
+    // Not empty: the A-buffer was refused (a pixel's list would exceed the limit, or the pool its
+    // 32-bit indices); nothing below is set and nothing was allocated for the fragments.
+    std::string error;
     int width = 0, height = 0;
     uint64_t fragments = 0;           // fragments stored (a triangle covering >= 1 sub-sample of a pixel)
     uint64_t coveredPixels = 0;       // pixels with a non-empty list
@@ -84,9 +91,10 @@ struct ABufferResult {
 // front winding) and resolves them: at each sub-sample the covering fragments sorted by their depth
 // there (double, from their planes; ties by lowest source), composited front to back
 // (color += T alpha c, T *= 1 - alpha, stopping when T reaches 0), the background under what is
-// left, and the 16 sub-samples averaged.
+// left, and the 16 sub-samples averaged. A first pass counts each pixel's fragments, so a list
+// longer than maxListLength is refused (ABufferResult::error) before the pool is allocated.
 ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height, bool orthographic,
-                             const ABufferMaterials &materials);
+                             const ABufferMaterials &materials, uint32_t maxListLength = kABufferDefaultMaxList);
 
 // ---- coverageMasks --------------------------------------------------------------------------------
 // The pixel box is every pixel any of whose samples may lie in the vertex box (a sample of pixel x

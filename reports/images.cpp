@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "reports/font.h"
@@ -38,17 +38,13 @@ using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
-std::atomic<unsigned> gTempCounter{0};
-
-// Writes one image with OpenImageIO to a temporary name in the same folder, then renames it over
-// `path` (rename within one folder is atomic: readers see the old file or the new one, never half).
-// `format` names the OIIO writer ("openexr", "png") because the temporary name has no extension.
+// Encodes one image with OpenImageIO in memory, then writes the bytes with writeFileAtomic (a
+// temporary name in the same folder, fsync, rename over `path`: readers see the old file or the
+// new one, never half). OpenImageIO's own file errors name no system reason ("Failed to write pixel
+// data"); writeFileAtomic's name the call and errno's text ("No space left on device").
 bool writeImageAtomic(const std::string &path, const char *format, const ImageSpec &spec, const void *pixels,
                       std::string *err) {
-    const std::string tmp =
-        path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gTempCounter.fetch_add(1));
     auto fail = [&](const std::string &msg) {
-        std::remove(tmp.c_str());
         if (err) *err = "cannot write image '" + path + "': " + msg;
         return false;
     };
@@ -59,14 +55,22 @@ bool writeImageAtomic(const std::string &path, const char *format, const ImageSp
     if (!stamped.find_attribute("DateTime")) stamped.attribute("DateTime", "");
     auto out = ImageOutput::create(format);
     if (!out) return fail("no OpenImageIO writer for " + std::string(format) + ": " + OIIO::geterror());
-    if (!out->open(tmp, stamped)) return fail(out->geterror());
+    OIIO::Filesystem::IOVecOutput encoded;
+    if (!out->supports("ioproxy") || !out->set_ioproxy(&encoded))
+        return fail("the OpenImageIO " + std::string(format) + " writer cannot write to memory");
+    if (!out->open(path, stamped)) return fail(out->geterror());
     if (!out->write_image(spec.format, pixels)) {
         const std::string msg = out->geterror();
         out->close();
         return fail(msg);
     }
     if (!out->close()) return fail(out->geterror());
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) return fail(std::string("rename: ") + std::strerror(errno));
+    const std::vector<unsigned char> &bytes = encoded.buffer();
+    std::string e;
+    if (!writeFileAtomic(path, std::string(bytes.begin(), bytes.end()), &e)) {
+        const std::string own = "cannot write '" + path + "': ";  // writeFileAtomic's prefix
+        return fail(e.rfind(own, 0) == 0 ? e.substr(own.size()) : e);
+    }
     return true;
 }
 

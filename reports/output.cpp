@@ -57,7 +57,45 @@ bool replaceable(const std::string &dir, std::string *why) {
 
 }  // namespace
 
+namespace {
+// Writes all of `contents` to fd (write(2) may write fewer bytes than asked); errno on failure.
+bool writeAll(int fd, const std::string &contents) {
+    size_t done = 0;
+    while (done < contents.size()) {
+        const ssize_t w = ::write(fd, contents.data() + done, contents.size() - done);
+        if (w < 0) {
+            if (errno == EINTR) continue;
+            return false;
+        }
+        done += size_t(w);
+    }
+    return true;
+}
+}  // namespace
+
 bool writeFileAtomic(const std::string &path, const std::string &contents, std::string *err) {
+    // A target that exists and is not a regular file (/dev/stdout, a FIFO, /dev/full) is written in
+    // place: renaming a temporary over it would replace the device node itself (as root, /dev is
+    // writable), and there is no half-written file to protect.
+    struct stat st;
+    if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+        const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+        if (fd < 0) {
+            if (err) *err = "cannot write '" + path + "': open: " + errnoText(errno);
+            return false;
+        }
+        if (!writeAll(fd, contents)) {
+            const int e = errno;
+            ::close(fd);
+            if (err) *err = "cannot write '" + path + "': write: " + errnoText(e);
+            return false;
+        }
+        if (::close(fd) != 0) {
+            if (err) *err = "cannot write '" + path + "': close: " + errnoText(errno);
+            return false;
+        }
+        return true;
+    }
     const std::string tmp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gCounter.fetch_add(1));
     auto fail = [&](const std::string &what, int e, bool removeTmp) {
         if (removeTmp) ::unlink(tmp.c_str());
@@ -66,18 +104,12 @@ bool writeFileAtomic(const std::string &path, const std::string &contents, std::
     };
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0) return fail("create '" + tmp + "'", errno, false);
-    // Write all bytes (write(2) may write fewer than asked), then flush them to the disk before the
-    // rename makes the file visible under its real name.
-    size_t done = 0;
-    while (done < contents.size()) {
-        const ssize_t w = ::write(fd, contents.data() + done, contents.size() - done);
-        if (w < 0) {
-            if (errno == EINTR) continue;
-            const int e = errno;
-            ::close(fd);
-            return fail("write", e, true);
-        }
-        done += size_t(w);
+    // Write all bytes, then flush them to the disk before the rename makes the file visible under
+    // its real name.
+    if (!writeAll(fd, contents)) {
+        const int e = errno;
+        ::close(fd);
+        return fail("write", e, true);
     }
     if (::fsync(fd) != 0) {
         const int e = errno;

@@ -527,7 +527,8 @@ TEST(Bsp, TriangleBudgetRefusedBeforeAllocating) {
     o.maxTriangles = 1000;
     EXPECT_EQ(parseError(tinyWriter().file(), o),
               "tiny.bsp: the map's drawn faces would make 8199 triangles and 4242 vertices at patch level 64, more "
-              "than the limit of 1000 triangles; lower the patch level (--patch-level), or the file is damaged");
+              "than the limit of 1000 triangles; lower the patch level (--patch-level) or raise the limit with "
+              "--max-triangles 8199, or the file is damaged");
     // Many faces sharing one large patch grid: 200 faces x 31 x 31 patches x 2 x 64^2.
     BspWriter w = tinyWriter();
     const int32_t first = int32_t(w.lump[LVertexes].size() / 44);
@@ -540,7 +541,8 @@ TEST(Bsp, TriangleBudgetRefusedBeforeAllocating) {
     o.maxTriangles = BspOptions{}.maxTriangles;
     EXPECT_EQ(parseError(w.file(), o),
               "tiny.bsp: the map's drawn faces would make 1574502400 triangles and 788045000 vertices at patch level 64, "
-              "more than the limit of 50000000 triangles; lower the patch level (--patch-level), or the file is damaged");
+              "more than the limit of 50000000 triangles; lower the patch level (--patch-level) or raise the limit with "
+              "--max-triangles 1574502400, or the file is damaged");
 }
 
 // Seeded byte corruption: every file is either read or refused with a message, and nothing crashes.
