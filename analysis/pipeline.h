@@ -66,7 +66,8 @@ struct MemoryEstimate {
     uint64_t prepared = 0;  // built once per scene: Embree's BVH, the object BVH and grid, the BSP tree
     uint64_t perView = 0;   // the largest view's buffers (per pixel and per triangle)
     uint64_t viewsInFlight = 0;  // views analysed at once (threads, at most the number of views)
-    uint64_t total = 0;     // baseline + scene + prepared + perView * viewsInFlight + finished views' results
+    uint64_t finishedViews = 0;  // what the finished views still hold (their results), all views
+    uint64_t total = 0;     // baseline + scene + prepared + perView * viewsInFlight + finishedViews
 };
 MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cams, const PipelineSettings &s);
 
