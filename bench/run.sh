@@ -3,7 +3,7 @@
 # same run (z-buffer vs Mesa llvmpipe, castPrimary vs raw rtcIntersect16, loading, analyze end to
 # end against its own timings, and a 10k..10M triangles x 1..64 views scaling table).
 #
-#   bash bench/run.sh                      # everything (about 15-25 min on 2 cores)
+#   bash bench/run.sh                      # everything (the 10M x 64 views case alone takes minutes)
 #   bash bench/run.sh --quick              # 3 repetitions; scaling without 10M triangles and 64 views
 #   bash bench/run.sh --sections zbuffer,llvmpipe,raycast,load,analyze,scaling [--reps N] [--keep]
 #
