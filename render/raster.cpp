@@ -18,6 +18,7 @@
 #include <tbb/task_arena.h>
 
 #include "render/depth_format_impl.h"
+#include "render/large_pages.h"
 #include "render/raster_core.h"
 #include "render/raster_kernel.h"
 
@@ -279,11 +280,12 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
     zb.width = std::max(width, 0);
     zb.height = std::max(height, 0);
     const size_t pixels = size_t(zb.width) * size_t(zb.height);
-    zb.key.assign(pixels, std::numeric_limits<uint32_t>::max());
-    zb.id.assign(pixels, 0);
-    zb.depth.assign(pixels, std::numeric_limits<double>::infinity());
-    zb.fragments.assign(pixels, 0);
-    zb.passes.assign(pixels, 0);
+    // Huge pages (render/large_pages.h): fragments land all over five 1080p buffers (40 MB).
+    assignOnLargePages(zb.key, pixels, std::numeric_limits<uint32_t>::max());
+    assignOnLargePages(zb.id, pixels, uint32_t(0));
+    assignOnLargePages(zb.depth, pixels, std::numeric_limits<double>::infinity());
+    assignOnLargePages(zb.fragments, pixels, uint16_t(0));
+    assignOnLargePages(zb.passes, pixels, uint16_t(0));
 
     ZBufferStats &st = r.stats;
     st.trianglesIn = tris.size();
