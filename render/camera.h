@@ -45,14 +45,6 @@ struct Camera {
 // non-finite values). The message names the field and the fix, not the file (the caller adds that).
 bool makeCamera(const CameraSpec &spec, Camera *cam, std::string *err);
 
-// World to view space, camera-relative: (right, up, -forward) . (p - eye). The difference p - eye
-// is exact where p is near the eye (Sterbenz), so precision follows the distance to the camera, not
-// to the world origin (viewFromWorld's r.p - r.eye loses the low bits of both products at 1e7).
-inline Vec3 viewFromWorldPoint(const Camera &cam, Vec3 p) {
-    const Vec3 d = p - cam.eye;
-    return {dot(cam.right, d), dot(cam.up, d), -dot(cam.forward, d)};
-}
-
 // The view-space ray direction through pixel coordinates (px, py) (perspective: origin at the eye,
 // direction with z = -1, so the ray parameter equals view depth; orthographic: the origin offset in
 // the view plane, direction (0, 0, -1)).

@@ -125,6 +125,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     std::vector<ClipVertex> cv;
     std::vector<uint32_t> code;
     std::vector<int32_t> screen;
+    const Mat4 &vw = cam.viewFromWorld;
 
     for (const ClipBatch &b : batches) {
         const uint32_t nv = b.vertexEnd - b.vertexBegin;
@@ -133,7 +134,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
         code.resize(nv);
         screen.resize(size_t(nv) * 2);
         for (uint32_t i = 0; i < nv; ++i) {
-            const Vec3 v = viewFromWorldPoint(cam, mesh.positions[b.vertexBegin + i]);
+            const Vec3 v = transformPoint(vw, mesh.positions[b.vertexBegin + i]);
             view[i] = v;
             const double d = -v.z;
             ClipVertex c{cam.sx * v.x, cam.sy * v.y, cam.orthographic ? 1.0 : d, d};
