@@ -1,5 +1,7 @@
 #include "render/raycast.h"
 
+#include "render/large_pages.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,7 +11,6 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-#include <sys/mman.h>
 #include <tbb/parallel_for.h>
 
 namespace va {
@@ -154,24 +155,6 @@ bool RayScene::build(const MeshView &mesh, size_t vertexCount, const std::vector
 }
 
 namespace {
-// v = n copies of x, asking the kernel to back v's memory with transparent huge pages where it can.
-// A 1080p image buffer is 8 MB of fresh memory on every call: faulting it in as 2,025 pages of
-// 4 KiB took 3.5 ms per buffer here, more than writing it, against 0.4 ms in 2 MiB pages; the
-// writes of a 4x4 packet span 4 rows, 4 pages apart at 4 KiB, one page at 2 MiB. (Embree asks the
-// same for its BVH.) Only a hint: where the kernel's THP setting is "never" nothing changes.
-template <class T>
-void assignOnLargePages(std::vector<T> &v, size_t n, T x) {
-    v.clear();
-    v.reserve(n);  // allocates without touching the pages
-#ifdef MADV_HUGEPAGE
-    constexpr uintptr_t kPage = 4096;
-    const uintptr_t b = (reinterpret_cast<uintptr_t>(v.data()) + kPage - 1) & ~(kPage - 1);
-    const uintptr_t e = (reinterpret_cast<uintptr_t>(v.data() + n)) & ~(kPage - 1);
-    if (e > b) madvise(reinterpret_cast<void *>(b), e - b, MADV_HUGEPAGE);
-#endif
-    v.assign(n, x);
-}
-
 // dst[0 .. n) = src[0 .. n) for 4-byte elements, with non-temporal stores where the target is
 // 16-byte aligned: a frame's output (16 MB and more) would otherwise pass through the caches and
 // evict the BVH nodes the next packets need.
