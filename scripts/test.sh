@@ -18,3 +18,6 @@ jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Release -DVISAUDIT_SANITIZE=ON -DVISAUDIT_BENCH=OFF >/dev/null
 cmake --build build-asan -j"$jobs" --target visaudit_tests
 (cd build-asan && ctest --output-on-failure -j"$jobs" -LE browser)
+# The loaders' libFuzzer targets (clang 14, ASan + UBSan): 3000 executions each from the seeds;
+# any crash, hang or leak fails the run (scripts/fuzz.sh; long runs are `scripts/fuzz.sh --seconds N`).
+bash scripts/fuzz.sh --smoke
