@@ -49,6 +49,21 @@ bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edge
     return side > 0;
 }
 
+std::vector<ClipBatch> clipBatches(const Scene &scene, const TriangleLists &lists) {
+    std::vector<ClipBatch> batches;
+    batches.reserve(lists.objects.size());
+    for (size_t g = 0; g < lists.objects.size(); ++g) {
+        const SceneObject &ob = scene.objects[lists.objects[g]];
+        ClipBatch b;
+        b.vertexBegin = ob.vertexBegin;
+        b.vertexEnd = ob.vertexEnd;
+        b.triangles = lists.triangles.data() + lists.groupBegin[g];
+        b.count = lists.groupBegin[g + 1] - lists.groupBegin[g];
+        if (b.count) batches.push_back(b);
+    }
+    return batches;
+}
+
 TriangleLists allTriangles(const Scene &scene, const std::vector<uint32_t> &objects) {
     TriangleLists l;
     l.objects = objects;

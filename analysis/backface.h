@@ -10,6 +10,7 @@
 #include "analysis/results.h"
 #include "analysis/scene.h"
 #include "render/camera.h"
+#include "render/clip.h"
 
 namespace va {
 
@@ -23,6 +24,9 @@ struct TriangleLists {
 
 // All triangles of the given objects, unculled.
 TriangleLists allTriangles(const Scene &scene, const std::vector<uint32_t> &objects);
+
+// The clip stage's input: one batch per non-empty group, pointing into `lists` (which must outlive it).
+std::vector<ClipBatch> clipBatches(const Scene &scene, const TriangleLists &lists);
 
 struct BackfaceResult {
     TriangleLists kept;

@@ -246,17 +246,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         StageRecord st;
         st.name = "clip";
         const auto t0 = Clock::now();
-        std::vector<ClipBatch> batches;
-        batches.reserve(lists.objects.size());
-        for (size_t g = 0; g < lists.objects.size(); ++g) {
-            const SceneObject &ob = scene.objects[lists.objects[g]];
-            ClipBatch b;
-            b.vertexBegin = ob.vertexBegin;
-            b.vertexEnd = ob.vertexEnd;
-            b.triangles = lists.triangles.data() + lists.groupBegin[g];
-            b.count = lists.groupBegin[g + 1] - lists.groupBegin[g];
-            if (b.count) batches.push_back(b);
-        }
+        const std::vector<ClipBatch> batches = clipBatches(scene, lists);
         clip = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, s.clip);
         st.ms = msSince(t0);
         st.ran = true;

@@ -221,17 +221,7 @@ Scene sceneOfMesh(RawMesh mesh) {
 
 // One clip batch per object group, as the pipeline's clip stage makes them.
 ClipResult clipLists(const Scene &s, const Camera &cam, const TriangleLists &lists) {
-    std::vector<ClipBatch> batches;
-    for (size_t g = 0; g < lists.objects.size(); ++g) {
-        const SceneObject &ob = s.objects[lists.objects[g]];
-        ClipBatch b;
-        b.vertexBegin = ob.vertexBegin;
-        b.vertexEnd = ob.vertexEnd;
-        b.triangles = lists.triangles.data() + lists.groupBegin[g];
-        b.count = lists.groupBegin[g + 1] - lists.groupBegin[g];
-        if (b.count) batches.push_back(b);
-    }
-    return clipTriangles(cam, MeshView{s.positions.data(), s.indices.data()}, batches, {});
+    return clipTriangles(cam, MeshView{s.positions.data(), s.indices.data()}, clipBatches(s, lists), {});
 }
 
 // ---- Child processes ---------------------------------------------------------------------------

@@ -79,17 +79,9 @@ Camera downCamera(double height, double nearZ, double farZ, int size = 64) {
 ScreenTriangles screenTriangles(const Scene &scene, const Camera &cam, bool backface = true) {
     const FrustumResult fr = cullFrustum(scene, buildObjectBvh(scene), cam);
     const TriangleLists lists = backface ? cullBackfaces(scene, fr.visible, cam).kept : allTriangles(scene, fr.visible);
-    std::vector<ClipBatch> batches;
-    for (size_t g = 0; g < lists.objects.size(); ++g) {
-        const SceneObject &ob = scene.objects[lists.objects[g]];
-        ClipBatch b;
-        b.vertexBegin = ob.vertexBegin;
-        b.vertexEnd = ob.vertexEnd;
-        b.triangles = lists.triangles.data() + lists.groupBegin[g];
-        b.count = lists.groupBegin[g + 1] - lists.groupBegin[g];
-        if (b.count) batches.push_back(b);
-    }
-    return clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    return clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, clipBatches(scene, lists),
+                         ClipSettings{})
+        .out;
 }
 
 const ZFightFormatStats &stats(const ZFightResult &r, DepthFormat f) {
