@@ -1,6 +1,6 @@
 // z-buffer throughput on the benchmark scene (analysis/bench_scene.h), one thread and all threads.
 //
-//   bench_zbuffer [--reps N] [--format NAME] [--tile-shift S]
+//   bench_zbuffer [--reps N] [--format NAME] [--tile-shift S] [--only K]
 //
 // Builds the 1,000,002-triangle sphere grid, clips and projects it once with the clip stage
 // (va::clipTriangles), then times va::rasterize() alone -- buffer allocation and clearing included,
@@ -27,6 +27,7 @@
 int main(int argc, char **argv) {
     int reps = 9;
     int tileShift = 0;
+    int only = -1;  // --only K: just configuration K (0-based, table order), e.g. for a profiler
     va::DepthFormat format = va::DepthFormat::f32;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) {
@@ -39,8 +40,10 @@ int main(int argc, char **argv) {
             }
         } else if (!std::strcmp(argv[i], "--tile-shift") && i + 1 < argc) {
             tileShift = std::atoi(argv[++i]);
+        } else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) {
+            only = std::atoi(argv[++i]);
         } else {
-            std::fprintf(stderr, "usage: bench_zbuffer [--reps N] [--format NAME] [--tile-shift S]\n");
+            std::fprintf(stderr, "usage: bench_zbuffer [--reps N] [--format NAME] [--tile-shift S] [--only K]\n");
             return 2;
         }
     }
@@ -138,10 +141,11 @@ int main(int argc, char **argv) {
     bool identical = true;
     for (size_t i = 0; i < configs.size(); ++i) {
         const Config &c = configs[i];
+        if (only >= 0 && size_t(only) != i) continue;
         const Timing t = run(tris, c.threads, c.strategy);
         std::printf("%-24s %7d %10.2f %10.2f %10.2f %12.2f %12.1f\n", c.name, c.threads, 1e3 * t.best,
                     1e3 * t.median, 1e3 * t.cpuBest, n / t.best * 1e-6, double(t.stats.fragments) / t.best * 1e-6);
-        if (i == 0) reference = t.stats;
+        if (i == 0 || (only >= 0 && size_t(only) == i)) reference = t.stats;
         identical = identical && t.stats.fragments == reference.fragments &&
                     t.stats.depthPasses == reference.depthPasses && t.stats.histogram == reference.histogram &&
                     t.stats.trianglesDrawn == reference.trianglesDrawn;
