@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 
 #include <embree3/rtcore.h>
@@ -291,9 +292,12 @@ void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int ban
     const int y0 = band * kTile, y1 = std::min(img.height, y0 + kTile);
     const size_t begin = size_t(y0) * w, count = size_t(y1 - y0) * w;
     // The band is traced into buffers of its own, which stay in cache while its tiles write them
-    // packet by packet, and then copied to its contiguous range of the image in one go.
-    std::vector<uint32_t> id(count);
-    std::vector<float> depth(count), u(kBary ? count : 0), v(kBary ? count : 0);
+    // packet by packet, and then copied to its contiguous range of the image in one go. Every
+    // pixel of the band is one valid lane of one packet, so the buffers need no clearing.
+    const auto id = std::make_unique_for_overwrite<uint32_t[]>(count);
+    const auto depth = std::make_unique_for_overwrite<float[]>(count);
+    const auto u = std::make_unique_for_overwrite<float[]>(kBary ? count : 0);
+    const auto v = std::make_unique_for_overwrite<float[]>(kBary ? count : 0);
     st.rays += count;
     rays.forEachPacket(band, [](int, int, int) {}, [&](int px, int py) {
         rays.fill(px, py, rh, valid);
@@ -315,11 +319,11 @@ void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int ban
             }
         }
     });
-    streamCopy(id.data(), count, img.id.data() + begin);
-    streamCopy(depth.data(), count, img.depth.data() + begin);
+    streamCopy(id.get(), count, img.id.data() + begin);
+    streamCopy(depth.get(), count, img.depth.data() + begin);
     if constexpr (kBary) {
-        streamCopy(u.data(), count, img.u.data() + begin);
-        streamCopy(v.data(), count, img.v.data() + begin);
+        streamCopy(u.get(), count, img.u.data() + begin);
+        streamCopy(v.get(), count, img.v.data() + begin);
     }
 }
 
