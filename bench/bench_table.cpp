@@ -253,11 +253,14 @@ ChildRun runChild(const std::vector<std::string> &argv, const fs::path &log) {
     return r;
 }
 
-// report.json: load + ray scene build + BSP tree + every view's stages and audits (the timed parts).
+// report.json: load + ray scene build + BSP tree + every view's stages and audits + the output
+// phase (images, the report in memory, report.html): the timed parts.
 struct ReportTimes {
     double loadMs = 0, raySceneMs = 0, bspMs = 0, stagesMs = 0, auditsMs = 0, viewsTotalMs = 0;
+    double imagesMs = 0, reportMs = 0, htmlMs = 0;
     size_t views = 0;
-    double sum() const { return loadMs + raySceneMs + bspMs + stagesMs + auditsMs; }
+    double outputMs() const { return imagesMs + reportMs + htmlMs; }
+    double sum() const { return loadMs + raySceneMs + bspMs + stagesMs + auditsMs + outputMs(); }
 };
 bool readReportTimes(const fs::path &p, ReportTimes *t, std::string *err) {
     std::ifstream f(p);
@@ -278,6 +281,11 @@ bool readReportTimes(const fs::path &p, ReportTimes *t, std::string *err) {
     t->loadMs = num(j, "load_ms");
     if (j.contains("effects")) t->raySceneMs = num(j["effects"], "ray_scene_build_ms");
     if (j.contains("bsp_tree") && j["bsp_tree"].is_object()) t->bspMs = num(j["bsp_tree"], "build_ms");
+    if (j.contains("output") && j["output"].is_object()) {
+        t->imagesMs = num(j["output"], "images_ms");
+        t->reportMs = num(j["output"], "report_ms");
+        t->htmlMs = num(j["output"], "html_ms");
+    }
     for (const auto &v : j["views"]) {
         ++t->views;
         t->viewsTotalMs += num(v, "total_ms");
@@ -590,10 +598,14 @@ int main(int argc, char **argv) {
                 table.notes.push_back(fmt("analyze timings (report.json, 1 thread): load_ms %.0f, ray_scene_build_ms %.0f, "
                                           "bsp_tree.build_ms %.0f, stages[].ms %.0f, audits' ms (audit, depth, ordering, "
                                           "detail, raycast.cross_check, raycast.effects) %.0f; views' total_ms %.0f; "
-                                          "process wall time not inside load, ray scene, BSP tree or a view's total_ms "
-                                          "(start-up, writing the report and images): %.0f ms",
+                                          "output.images_ms %.0f, output.report_ms %.0f, output.html_ms %.0f; process "
+                                          "wall time not inside load, ray scene, BSP tree, a view's total_ms or the output "
+                                          "phase (start-up and dynamic linking, writing report.json, the folder swap, "
+                                          "freeing at exit): %.0f ms",
                                           rt.loadMs, rt.raySceneMs, rt.bspMs, rt.stagesMs, rt.auditsMs, rt.viewsTotalMs,
-                                          1e3 * c.wallS - rt.loadMs - rt.raySceneMs - rt.bspMs - rt.viewsTotalMs));
+                                          rt.imagesMs, rt.reportMs, rt.htmlMs,
+                                          1e3 * c.wallS - rt.loadMs - rt.raySceneMs - rt.bspMs - rt.viewsTotalMs -
+                                              rt.outputMs()));
             } else {
                 table.add({fmt("analyze, all threads (%u): process wall time", cores),
                            fmt("%.2f s, peak %.0f MiB", c.wallS, c.peakMiB),

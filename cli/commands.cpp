@@ -305,10 +305,14 @@ int analyzeToReport(const Options &o,
     const bool tty = isatty(fileno(stderr));
     std::atomic<int> done{0};
     std::mutex printMutex;
+    auto msSince = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+    std::vector<double> imagesMs(views.size(), 0.0);  // per view: each slot written by one worker
     auto onView = [&](size_t i, ViewResult &v, std::string *e) {
         v.index = indices[i];
         v.imageBase = bases[i];
+        const auto w0 = Clock::now();
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
+        imagesMs[i] = msSince(w0);
         v.buffer = ZBuffer{};  // the images hold it now
         v.ordering.painter.id = {};
         v.ordering.painter.cls = {};
@@ -353,13 +357,24 @@ int analyzeToReport(const Options &o,
     }
     if (tty && !o.quiet) std::fprintf(stderr, "\n");
     result.loadMs = loadMs;
+    OutputTimings outputMs;
+    for (double ms : imagesMs) outputMs.imagesMs += ms;
+    const auto r0 = Clock::now();
     *report = reportJson(result);
+    outputMs.reportMs = msSince(r0);
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was. A signal is honoured up to the
     // commit; the swap itself is not interrupted (the handler only sets a flag), and a run whose
-    // report is in place has finished.
-    if (!writeFileAtomic(out.staging() + "/report.json", report->dump(2) + "\n", &err) ||
-        !writeReportHtml(*report, out.staging(), &err)) {
+    // report is in place has finished. report.html is written first so that report.json can say
+    // how long it took.
+    const auto h0 = Clock::now();
+    if (!writeReportHtml(*report, out.staging(), &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    outputMs.htmlMs = msSince(h0);
+    addOutputTimings(report, outputMs);
+    if (!writeFileAtomic(out.staging() + "/report.json", report->dump(2) + "\n", &err)) {
         fail(err);
         return kExitBadInput;
     }

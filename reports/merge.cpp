@@ -145,6 +145,18 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
         m[key] = value;
     }
     m["shard"] = {{"index", 1}, {"count", 1}, {"views_total", total}};
+    // "output": what every shard spent writing its files, summed (the copy above is shard 1's).
+    if (m.contains("output") && m["output"].is_object())
+        for (auto &[key, value] : m["output"].items()) {
+            double sum = 0;
+            bool finite = true;
+            for (const Json &r : reports) {
+                const Json *x = r.contains("output") && r["output"].contains(key) ? &r["output"][key] : nullptr;
+                if (x && x->is_number()) sum += x->get<double>();
+                else finite = false;
+            }
+            value = finite ? Json(sum) : Json(nullptr);
+        }
     Json list = Json::array();
     for (const Json *v : views) list.push_back(*v);
     m["views"] = list;

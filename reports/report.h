@@ -20,6 +20,17 @@ nlohmann::ordered_json reportJson(const AnalysisResult &result);
 // The report's "totals" computed from its "views" array alone (reportJson and merge share it).
 nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views);
 
+// The output phase's timings in milliseconds (report.json's "output"): writing the files takes as
+// long as the analysis itself at full HD, so it is timed like a stage, not hidden in the wall time.
+struct OutputTimings {
+    double imagesMs = 0;  // every view's images: pixels colored, encoded, written (sum over views)
+    double reportMs = 0;  // the report built in memory (reportJson)
+    double htmlMs = 0;    // report.html rendered and written
+};
+// Appends "output" to a report made by reportJson. Serializing and writing report.json itself
+// comes after, so it is the one part of the output phase that the report cannot time.
+void addOutputTimings(nlohmann::ordered_json *report, const OutputTimings &t);
+
 // ---- Image file names ------------------------------------------------------------------------
 // A view name made safe as a file name: [A-Za-z0-9._-] kept, every other byte replaced by '_'
 // (a multi-byte UTF-8 character becomes one '_' per byte), a leading '.' replaced by '_' (no

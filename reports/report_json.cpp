@@ -663,6 +663,10 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
     return j;
 }
 
+void addOutputTimings(nlohmann::ordered_json *report, const OutputTimings &t) {
+    (*report)["output"] = {{"images_ms", num(t.imagesMs)}, {"report_ms", num(t.reportMs)}, {"html_ms", num(t.htmlMs)}};
+}
+
 // Totals over views, computed from the views' JSON alone, so that `merge` recomputes exactly what a
 // single run writes: per-stage culled triangles (stages in order of first appearance, which is
 // DESIGN.md's fixed order), z-buffer sums.

@@ -106,6 +106,12 @@ TEST_F(CliTest, AnalyzeDemoWritesReportAndImages) {
     uint64_t covered = 0;
     for (uint32_t v : img.u32) covered += v != 0;
     EXPECT_EQ(covered, j["views"][0]["zbuffer"]["covered_pixels"].get<uint64_t>());
+    // The output phase is timed (issue 8: no hidden overhead): eight images and an HTML page take
+    // more than zero milliseconds.
+    ASSERT_TRUE(j.contains("output"));
+    EXPECT_GT(j["output"]["images_ms"].get<double>(), 0.0);
+    EXPECT_GE(j["output"]["report_ms"].get<double>(), 0.0);
+    EXPECT_GT(j["output"]["html_ms"].get<double>(), 0.0);
     // No staging folder is left behind.
     for (const auto &e : fs::directory_iterator(dir_))
         EXPECT_EQ(e.path().filename().string().find("report.tmp"), std::string::npos) << e.path();
@@ -294,6 +300,12 @@ TEST_F(CliTest, FourShardsThroughGnuParallelMergeIntoTheSingleRunsReport) {
     const auto single = withoutTimings(nlohmann::json::parse(slurp(dir_ / "single" / "report.json")));
     const auto merged = withoutTimings(nlohmann::json::parse(slurp(dir_ / "merged" / "report.json")));
     EXPECT_EQ(single, merged);
+    // The merged report's output timings are the shards' summed.
+    double imagesMs = 0;
+    for (const char *k : {"shard1", "shard2", "shard3", "shard4"})
+        imagesMs += nlohmann::json::parse(slurp(dir_ / k / "report.json"))["output"]["images_ms"].get<double>();
+    EXPECT_DOUBLE_EQ(nlohmann::json::parse(slurp(dir_ / "merged" / "report.json"))["output"]["images_ms"].get<double>(),
+                     imagesMs);
     // Every image is byte-identical too.
     size_t images = 0;
     for (const auto &e : fs::directory_iterator(dir_ / "single")) {

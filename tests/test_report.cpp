@@ -425,6 +425,29 @@ TEST(ReportJson, NonFiniteNumbersBecomeNull) {
     EXPECT_TRUE(validateReport(loadSchema(), j).empty());
 }
 
+// The output phase's timings: appended as "output", null when not finite, valid against the
+// schema, and stripped with the other timings (the determinism comparisons ignore them).
+TEST(ReportJson, OutputTimings) {
+    Json j = reportJson(syntheticResult());
+    EXPECT_FALSE(j.contains("output"));
+    const Json before = j;
+    addOutputTimings(&j, {1250.5, 0.75, std::numeric_limits<double>::infinity()});
+    EXPECT_EQ(j["output"].dump(), R"({"images_ms":1250.5,"report_ms":0.75,"html_ms":null})");
+    EXPECT_EQ(j.items().begin().key(), "format");  // appended, the rest keeps its order
+    const auto errors = validateReport(loadSchema(), j);
+    for (const auto &e : errors) ADD_FAILURE() << e;
+    EXPECT_TRUE(errors.empty());
+    Json bad = j;
+    bad["output"]["encode_ms"] = 1;
+    EXPECT_EQ(validateReport(loadSchema(), bad).size(), 1u);
+    stripTimes(j);
+    EXPECT_EQ(j["output"].dump(), "{}");
+    j.erase("output");
+    Json b = before;
+    stripTimes(b);
+    EXPECT_EQ(j.dump(), b.dump());
+}
+
 TEST(ReportJson, EmptyResult) {
     const Json j = reportJson(AnalysisResult{});
     EXPECT_EQ(j["views"].dump(), "[]");
