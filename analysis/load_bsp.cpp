@@ -658,7 +658,7 @@ bool loadBspScene(const std::string &path, const BspOptions &opt, const ChunkSet
     SceneBuildInput in;
     BspLevel level;
     if (!parseBsp(bytes.data(), bytes.size(), path, opt, &in, &level, err)) return false;
-    bytes = {};
+    std::vector<uint8_t>().swap(bytes);  // the file's bytes are parsed: free them before the scene build
     Scene s;
     std::string e;
     if (!buildScene(std::move(in), chunks, &s, &e)) {

@@ -426,12 +426,9 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     const uint64_t threads = s.threads > 0 ? uint64_t(s.threads) : uint64_t(tbb::info::default_concurrency());
     m.viewsInFlight = std::min<uint64_t>(threads, cams.size());
     constexpr uint64_t kBaseline = 128ull << 20;  // the program, its libraries, TBB's and Embree's pools
-    // What a finished view still holds once its images are written: its result (statistics,
-    // hotspot and offender lists: 64 KiB) and, measured, 40 bytes per pixel more. On oa_thor's
-    // spawn views at 1920 x 1080 the peak grows by about 75 MB per finished view even on one thread
-    // and with no malloc threshold games (docs/limits.md); until that is found and released, the
-    // estimate counts it rather than let a long run die of it.
-    for (const Camera &c : cams) m.finishedViews += (64ull << 10) + 40 * uint64_t(c.width) * uint64_t(c.height);
+    // What a finished view still holds once its images are written (releasePixelBuffers): its
+    // result -- statistics, hotspot and offender lists -- about 64 KiB whatever its resolution.
+    m.finishedViews = uint64_t(cams.size()) * (64ull << 10);
     m.total = kBaseline + m.scene + m.prepared + m.perView * m.viewsInFlight + m.finishedViews;
     return m;
 }

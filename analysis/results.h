@@ -97,6 +97,38 @@ struct ViewResult {
     double totalMs = 0;
 };
 
+// Frees a vector's memory. (`v = {}` only empties it: it assigns from an empty initializer list,
+// which keeps the capacity -- the per-pixel buffers of every finished view stayed allocated that way.)
+template <class T>
+void freeMemory(std::vector<T> &v) {
+    std::vector<T>().swap(v);
+}
+
+// Frees every per-pixel buffer of a view once its images are written; what the report reads (the
+// statistics, hotspot and offender lists) stays.
+inline void releasePixelBuffers(ViewResult &v) {
+    v.buffer = ZBuffer{};
+    freeMemory(v.ordering.painter.id);
+    freeMemory(v.ordering.painter.cls);
+    freeMemory(v.ordering.bsp.id);
+    freeMemory(v.ordering.bsp.cls);
+    freeMemory(v.ordering.scanline.id);
+    freeMemory(v.ordering.abuffer.rgb);
+    freeMemory(v.ordering.abuffer.edge);
+    freeMemory(v.reference.id);
+    freeMemory(v.reference.depth);
+    freeMemory(v.reference.pixelsOf);
+    freeMemory(v.cullAudit.fate);
+    freeMemory(v.zfight.pixelClass);
+    freeMemory(v.zfight.fightMask);
+    freeMemory(v.zfight.hotspotOf);
+    v.raycastImage = RaycastImage{};
+    freeMemory(v.crossCheck.cls);
+    freeMemory(v.effects.shadowMask);
+    freeMemory(v.effects.secondaryDepth);
+    freeMemory(v.effects.secondaryRays);
+}
+
 struct AnalysisResult {
     std::string scenePath;
     SceneStats sceneStats;

@@ -313,26 +313,7 @@ int analyzeToReport(const Options &o,
         const auto w0 = Clock::now();
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
         imagesMs[i] = msSince(w0);
-        v.buffer = ZBuffer{};  // the images hold it now
-        v.ordering.painter.id = {};
-        v.ordering.painter.cls = {};
-        v.ordering.bsp.id = {};
-        v.ordering.bsp.cls = {};
-        v.ordering.scanline.id = {};
-        v.ordering.abuffer.rgb = {};
-        v.ordering.abuffer.edge = {};
-        v.reference.id = {};
-        v.reference.depth = {};
-        v.reference.pixelsOf = {};
-        v.cullAudit.fate = {};
-        v.zfight.pixelClass = {};
-        v.zfight.fightMask = {};
-        v.zfight.hotspotOf = {};
-        v.raycastImage = RaycastImage{};
-        v.crossCheck.cls = {};
-        v.effects.shadowMask = {};
-        v.effects.secondaryDepth = {};
-        v.effects.secondaryRays = {};
+        releasePixelBuffers(v);  // the images hold them now
         const int k = ++done;
         if (!o.quiet) {
             // A terminal gets one line rewritten in place with an estimate of the time left; a log
