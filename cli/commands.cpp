@@ -302,6 +302,7 @@ int analyzeToReport(const Options &o,
         fail(err);
         return kExitBadInput;
     }
+    setImageThreads(o.threads);
     const bool tty = isatty(fileno(stderr));
     std::atomic<int> done{0};
     std::mutex printMutex;

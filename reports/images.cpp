@@ -31,6 +31,11 @@
 
 namespace va {
 
+void setImageThreads(int threads) {
+    OIIO::attribute("threads", threads);
+    OIIO::attribute("exr_threads", threads);
+}
+
 namespace {
 
 using OIIO::ImageInput;
