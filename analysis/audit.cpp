@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <unordered_map>
 
+#include "analysis/backface.h"
 #include "render/raster.h"
 #include "render/raster_core.h"
 
@@ -20,10 +22,14 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 // The reference as a fragment sink: single-sided triangles only with the front winding, LESS on
 // the double depth with ties to the lowest id (so the order of submission does not matter).
 struct ReferenceSink {
+    const Scene &scene;
+    const Camera &cam;
+    const int32_t *xy;  // the screen triangles' fixed-point corners
     const uint32_t *source;
     const uint8_t *singleSided;
     uint32_t *id;
     double *depth;
+    uint8_t *snappedFront;
     uint32_t current = 0;  // 1 + source of the triangle being walked
     uint64_t backWinding = 0, fragments = 0;
 
@@ -33,8 +39,23 @@ struct ReferenceSink {
             ++backWinding;
             return false;
         }
+        if (singleSided[s] && isSnappedSliver(t) && !isFrontFacing(scene, s, cam)) snappedFront[s] = 1;
         current = s + 1;
         return true;
+    }
+    // Whether snapping can have flipped the winding of front-wound screen triangle t. Each corner
+    // is the projected point rounded to the nearest fixed-point unit (toFixed), so each component
+    // of the edges e1 = v1 - v0, e2 = v2 - v0 is off by at most 1 unit, and twice the area
+    // A = e1.x e2.y - e1.y e2.x by at most |e1.x| + |e1.y| + |e2.x| + |e2.y| + 2 (the projection's
+    // own rounding, relative 2^-50 of coordinates below 2^30, adds far less than the + 2 more of
+    // slack). The exact winding can only differ from the snapped one (A < 0: front) when |A| is
+    // within that bound. The exact test runs only then: slivers are rare, so it costs nothing.
+    bool isSnappedSliver(size_t t) const {
+        const int32_t *v = xy + 6 * t;
+        const int64_t e1x = int64_t(v[2]) - v[0], e1y = int64_t(v[3]) - v[1];
+        const int64_t e2x = int64_t(v[4]) - v[0], e2y = int64_t(v[5]) - v[1];
+        const int64_t area = e1x * e2y - e1y * e2x;
+        return -area <= std::abs(e1x) + std::abs(e1y) + std::abs(e2x) + std::abs(e2y) + 4;
     }
     void fragment(size_t i, size_t, double d) {
         const double old = depth[i];
@@ -124,10 +145,13 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
     r.id.assign(pixels, 0);
     r.depth.assign(pixels, std::numeric_limits<double>::infinity());
     const std::vector<uint8_t> single = singleSidedTriangles(scene);
-    ReferenceSink sink{clip.out.source.data(), single.data(), r.id.data(), r.depth.data()};
+    r.snappedFront.assign(scene.triangleCount(), 0);
+    ReferenceSink sink{scene,         cam,         clip.out.xy.data(), clip.out.source.data(), single.data(),
+                       r.id.data(),   r.depth.data(), r.snappedFront.data()};
     forEachFragment(clip.out, r.width, r.height, cam.orthographic, sink);
     r.backWinding = sink.backWinding;
     r.fragments = sink.fragments;
+    for (uint8_t f : r.snappedFront) r.snappedFrontTriangles += f;
 
     r.pixelsOf.assign(scene.triangleCount(), 0);
     for (uint32_t id : r.id)
@@ -155,7 +179,7 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
     const size_t nt = scene.triangleCount();
 
     // The stage that culled each triangle first (1 + index; 0 = none). A per-pixel fate is a byte,
-    // 3 + k, so at most 253 stages (the pipeline has 5 culling stages).
+    // 4 + k, so at most 252 stages (the pipeline has 5 culling stages).
     const size_t nStages = std::min<size_t>(stages.size(), 255 - kFateCulledFirst + 1);
     std::vector<uint8_t> culledBy(nt, 0);
     a.stages.resize(nStages);
@@ -177,6 +201,11 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
         for (uint32_t t : stages[k].triangles) cull(t);
     }
 
+    // A triangle culled by a facing stage that the reference shows only through snapping.
+    auto isSnapped = [&](size_t t, size_t k) {
+        return stages[k].byFacing && t < ref.snappedFront.size() && ref.snappedFront[t];
+    };
+
     // False culls: culled triangles that the reference shows; aggregated per object for the
     // worst-offender lists.
     struct Agg {
@@ -187,6 +216,11 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
         if (!culledBy[t] || !ref.pixelsOf.size() || ref.pixelsOf[t] == 0) continue;
         const size_t k = culledBy[t] - 1;
         StageCullAudit &sa = a.stages[k];
+        if (isSnapped(t, k)) {
+            ++sa.snappedTriangles;
+            sa.snappedPixels += ref.pixelsOf[t];
+            continue;
+        }
         ++sa.falseCullTriangles;
         sa.falseCullPixels += ref.pixelsOf[t];
         Agg &g = perObject[k][scene.triangleObject[t]];
@@ -239,6 +273,7 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
         if (!id) continue;
         const uint32_t t = id - 1;
         if (drawn[t]) a.fate[i] = kFateDrawn;
+        else if (culledBy[t] && isSnapped(t, culledBy[t] - 1)) a.fate[i] = kFateSnapped;
         else if (culledBy[t]) a.fate[i] = uint8_t(kFateCulledFirst + culledBy[t] - 1);
         else {
             a.fate[i] = kFateUnaccounted;

@@ -40,6 +40,11 @@ struct ReferenceVisibility {
     uint64_t visibleTriangles = 0;    // source triangles visible at one pixel or more
     uint64_t visibleObjects = 0;      // culling objects with a visible triangle
     uint64_t coveredPixels = 0;       // pixels showing a triangle
+    // Per source triangle: 1 when the reference drew it only because snapping to the fixed-point
+    // grid turned a sliver's winding to the front, while its exact orientation (isFrontFacing, the
+    // backface stage's test) is back or edge-on (docs/audits.md, "Snapped slivers").
+    std::vector<uint8_t> snappedFront;
+    uint64_t snappedFrontTriangles = 0;
     double ms = 0;                    // wall time (clip + rasterize + counts)
 };
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam);
@@ -53,6 +58,9 @@ struct StageCulls {
     std::string stage;                // "frustum", "backface", ...
     std::vector<uint32_t> objects;    // culling objects culled as a whole
     std::vector<uint32_t> triangles;  // source triangles culled individually
+    bool byFacing = false;            // culls by the side facing the eye (backface): its culled
+                                      //   triangles the reference shows only as snapped slivers
+                                      //   (ReferenceVisibility::snappedFront) are not false culls
 };
 
 constexpr size_t kWorstOffenders = 20;
@@ -71,6 +79,8 @@ struct StageCullAudit {
     uint64_t falseCullTriangles = 0;  // culled, yet visible in the reference; best 0
     uint64_t falseCullObjects = 0;    // objects with a falsely culled triangle; best 0
     uint64_t falseCullPixels = 0;     // reference pixels showing a falsely culled triangle; best 0
+    uint64_t snappedTriangles = 0;    // byFacing: culled triangles the reference shows only as
+    uint64_t snappedPixels = 0;       //   snapped slivers, and their pixels (rounding, not false culls)
     std::vector<FalseCullOffender> worst;  // up to kWorstOffenders, most pixels first (ties: more
                                            //   triangles, then lower object index)
 };
@@ -81,7 +91,8 @@ enum : uint8_t {
     kFateDrawn = 1,          // its triangle reached the z-buffer
     kFateUnaccounted = 2,    // its triangle neither reached the z-buffer nor was culled by a listed
                              //   stage (dropped elsewhere: a pipeline bug); best: no such pixel
-    kFateCulledFirst = 3,    // 3 + k: falsely culled by stages[k]
+    kFateSnapped = 3,        // culled by facing, shown by the reference only as a snapped sliver
+    kFateCulledFirst = 4,    // 4 + k: falsely culled by stages[k]
 };
 
 struct CullAudit {

@@ -229,7 +229,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             st.ran = true;
             r.backface = b.stats;
             lists = std::move(b.kept);
-            if (s.audit) culls.push_back({"backface", {}, std::move(b.culled)});
+            if (s.audit) culls.push_back({"backface", {}, std::move(b.culled), true});
             st.trianglesIn = trianglesOf(scene, objects);
             st.trianglesOut = lists.size();
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;

@@ -62,6 +62,8 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
                      uint8_t(g * kCullDrawnTint.b / 255)};
             } else if (f == kFateUnaccounted) {
                 c = kCullUnaccounted;
+            } else if (f == kFateSnapped) {
+                c = kCullSnapped;
             } else if (f >= kFateCulledFirst) {
                 c = cullStageColor(f - kFateCulledFirst);
             }
@@ -71,6 +73,9 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
     for (size_t k = 0; k < audit.stages.size(); ++k)
         legend.push_back({cullStageColor(k), "false cull: " + audit.stages[k].stage + " (" +
                                                  std::to_string(audit.stages[k].falseCullPixels) + " px)"});
+    uint64_t snapped = 0;
+    for (const StageCullAudit &s : audit.stages) snapped += s.snappedPixels;
+    if (snapped) legend.push_back({kCullSnapped, "snapped sliver (" + std::to_string(snapped) + " px)"});
     if (audit.unaccountedPixels) legend.push_back({kCullUnaccounted, "unaccounted"});
     int CH = 0;
     const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);

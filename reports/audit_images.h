@@ -31,6 +31,7 @@ AuditImageNames auditImageNames(const std::string &baseName);
 Rgb8 cullStageColor(size_t stage);
 constexpr Rgb8 kCullDrawnTint{255, 255, 255};  // multiplied by the depth gray
 constexpr Rgb8 kCullUnaccounted{255, 0, 255};
+constexpr Rgb8 kCullSnapped{150, 150, 200};  // culled by facing, shown only as a snapped sliver
 Rgb8 disagreementColor(Disagreement d);  // none: black (not used: the dimmed image shows)
 
 // BASE.culling.png from a view's reference and culling audit.

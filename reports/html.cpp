@@ -1237,6 +1237,15 @@ void HtmlWriter::falseCulls(const Json *v, const std::string &id, const std::vec
         if (haveImg && fcPx > 0)
             o += "<p class=\"note\">Pixel links go to the culling-fates image, where each stage's false culls have the color "
                  "its legend strip names.</p>";
+        double snappedTris = 0, snappedPx = 0;
+        for (auto it = byStage->begin(); it != byStage->end(); ++it) {
+            snappedTris += numOr(&it.value(), {"snapped_triangles"}, 0);
+            snappedPx += numOr(&it.value(), {"snapped_pixels"}, 0);
+        }
+        if (snappedTris > 0)
+            o += "<p class=\"note\">Not counted above: " + plural(snappedTris, "back-facing sliver", "back-facing slivers") +
+                 " (" + plural(snappedPx, "pixel", "pixels") + ") culled rightly by the backface stage: the reference "
+                 "sees a front winding only because snapping to the 1/256-pixel grid flipped it.</p>";
     }
     if (const Json *w = get(a, "wasted_draws"); w && w->is_object())
         o += "<p>Wasted draws: " + fmtCount(numOr(w, {"triangles"}, 0)) + " of " + fmtCount(numOr(w, {"drawn_triangles"}, 0)) +

@@ -435,6 +435,8 @@ Json auditJson(const ViewResult &v) {
                             {"false_cull_triangles", s.falseCullTriangles},
                             {"false_cull_objects", s.falseCullObjects},
                             {"false_cull_pixels", s.falseCullPixels},
+                            {"snapped_triangles", s.snappedTriangles},
+                            {"snapped_pixels", s.snappedPixels},
                             {"worst", worst}};
         falseObjects += s.falseCullObjects;
     }

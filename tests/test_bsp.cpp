@@ -14,6 +14,8 @@
 #include <set>
 #include <unistd.h>
 
+#include "analysis/audit.h"
+#include "analysis/backface.h"
 #include "analysis/cells.h"
 #include "analysis/level_views.h"
 #include "analysis/load.h"
@@ -1024,3 +1026,37 @@ TEST(Cells, RealMapsFirstSpawnExactCounts) {
         EXPECT_EQ(c.trianglesIn, w.trianglesIn) << w.path;
     }
 }
+
+
+// A 1-pixel sliver of oa_thor seen from spawn120 is back-facing by the exact plane test, so the
+// backface stage culls it, but its corners snapped to the 1/256-pixel grid wind to the front, so
+// the reference shows it. The audit counts it as a snapped sliver, not a false cull (docs/audits.md,
+// "Snapped slivers"); without the stage's byFacing flag it is the false cull it used to be.
+TEST(Audit, RealMapSnappedSliverIsNotAFalseCull) {
+    REQUIRE_OA("pak6-patch088.pk3");
+    const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
+    const std::vector<ViewSpec> views = spawnViews(s);
+    ASSERT_GT(views.size(), 120u);
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(views[120].camera, &cam, &err)) << err;
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    EXPECT_GE(ref.snappedFrontTriangles, 1u);
+    std::vector<uint32_t> objects(s.objects.size());
+    for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
+    const BackfaceResult b = cullBackfaces(s, objects, cam);
+    for (bool byFacing : {true, false}) {
+        const CullAudit a = auditCulling(s, ref, {{"backface", {}, b.culled, byFacing}}, b.kept.triangles, nullptr);
+        ASSERT_EQ(a.stages.size(), 1u);
+        const StageCullAudit &st = a.stages[0];
+        EXPECT_EQ(st.falseCullTriangles, byFacing ? 0u : 1u);
+        EXPECT_EQ(st.falseCullPixels, byFacing ? 0u : 1u);
+        EXPECT_EQ(st.snappedTriangles, byFacing ? 1u : 0u);
+        EXPECT_EQ(st.snappedPixels, byFacing ? 1u : 0u);
+        uint64_t snappedFate = 0, culledFate = 0;
+        for (uint8_t f : a.fate) snappedFate += f == kFateSnapped, culledFate += f == kFateCulledFirst;
+        EXPECT_EQ(snappedFate, byFacing ? 1u : 0u);
+        EXPECT_EQ(culledFate, byFacing ? 0u : 1u);
+    }
+}
+
