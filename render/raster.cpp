@@ -65,7 +65,7 @@ struct ZBufferSink {
         return true;
     }
 
-    void fragment(size_t idx, size_t, double d) {
+    [[gnu::always_inline]] void fragment(size_t idx, size_t, double d) {
         fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
         // LESS: on equal keys (or equal depths) the first drawn fragment stays. Written as selects,
         // not a branch: about half the fragments pass, in no predictable pattern.

@@ -79,7 +79,7 @@ constexpr uint64_t kRowStarts = 0x0101010101010101ull;  // bit 0 of each of 8 ro
 // values r[k] (bias included), stepX/stepY as in EdgeSetup, all in int32 (see kBlockExtent).
 // No data-dependent branch: the loops have constant trip counts and unroll.
 template <int kRows, int kCols>
-inline uint64_t blockCoverage(const int32_t r[3], const int32_t stepX[3], const int32_t stepY[3]) {
+[[gnu::always_inline]] inline uint64_t blockCoverage(const int32_t r[3], const int32_t stepX[3], const int32_t stepY[3]) {
 #if defined(__SSE2__)
     // Lanes are columns; a center is outside when any edge value is negative, i.e. when the sign
     // bit of e0 | e1 | e2 is set (movemask gathers four sign bits).
