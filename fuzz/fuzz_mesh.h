@@ -1,5 +1,6 @@
 // One mesh file through loadScene (loadMeshFile, then buildScene), as `visaudit analyze x.EXT` reads
-// it. Included by fuzz_obj.cpp, fuzz_ply.cpp, fuzz_off.cpp and fuzz_stl.cpp with VISAUDIT_FUZZ_EXT.
+// it (glTF and GLB through fuzz_gltf.h). Included by fuzz_obj.cpp, fuzz_ply.cpp, fuzz_off.cpp and
+// fuzz_stl.cpp with VISAUDIT_FUZZ_EXT.
 #include "analysis/load.h"
 #include "fuzz/fuzz_util.h"
 

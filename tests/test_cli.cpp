@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "reports/report.h"
+#include "tests/temp_dir_test.h"
 
 namespace fs = std::filesystem;
 
@@ -31,15 +32,9 @@ std::string slurp(const fs::path &p) {
     return s.str();
 }
 
-class CliTest : public ::testing::Test {
+class CliTest : public va::testing_util::TempDirTest {
   protected:
-    void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("visaudit-cli-" + std::to_string(getpid()) + "-" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    CliTest() : TempDirTest("cli") {}
 
     // Runs the program with `args` (already shell-quoted where needed), no stdin.
     RunResult run(const std::string &args) {
@@ -53,7 +48,6 @@ class CliTest : public ::testing::Test {
         r.err = slurp(e);
         return r;
     }
-    fs::path dir_;
 };
 
 // The report without its timings ("ms" and "*_ms" keys), which differ between runs.

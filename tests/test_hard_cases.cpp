@@ -21,6 +21,7 @@
 #include "analysis/load.h"
 #include "analysis/pipeline.h"
 #include "render/depth_format.h"
+#include "tests/temp_dir_test.h"
 #include "tests/test_util.h"
 
 using namespace va;
@@ -96,15 +97,9 @@ RawMesh squareAt(double z, double h) {
 
 // ---- Files and the program ----------------------------------------------------------------------
 
-class HardInput : public ::testing::Test {
+class HardInput : public testing_util::TempDirTest {
   protected:
-    void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("visaudit-hard-" + std::to_string(getpid()) + "-" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    HardInput() : TempDirTest("hard") {}
 
     std::string write(const std::string &name, const std::string &bytes) {
         const std::string p = (dir_ / name).string();
@@ -142,7 +137,6 @@ class HardInput : public ::testing::Test {
             if (text[i] == '\n') ++line, start = i + 1;
         return file + ":" + std::to_string(line) + ":" + std::to_string(off - start + 1);
     }
-    fs::path dir_;
 };
 
 std::string le32(uint32_t v) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "tests/run_binary.h"
+#include "tests/temp_dir_test.h"
 
 namespace va {
 namespace {
@@ -61,17 +62,17 @@ bool catches(pid_t pid, int sig) {
     return false;
 }
 
-class NothingLost : public ::testing::Test {
+class NothingLost : public testing_util::TempDirTest {
   protected:
+    NothingLost() : TempDirTest("lost") {}
+
     void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("visaudit-lost-" + std::to_string(getpid()) + "-" + info->name());
-        fs::remove_all(dir_);
+        TempDirTest::SetUp();
         fs::create_directories(dir_ / "logs");
     }
     void TearDown() override {
         if (mounted_) ::umount2(mount_.c_str(), MNT_DETACH);
-        fs::remove_all(dir_);
+        TempDirTest::TearDown();
     }
     // A tmpfs of `bytes` at dir_/mnt; false (and the test skips) where mounting is not permitted.
     bool mountTmpfs(uint64_t bytes) {
@@ -93,7 +94,7 @@ class NothingLost : public ::testing::Test {
                                  dir_ / "logs");
         ASSERT_EQ(r.code, 0) << r.err;
     }
-    fs::path dir_, mount_;
+    fs::path mount_;
     bool mounted_ = false;
     std::string skipWhy_;
 };

@@ -18,6 +18,7 @@
 #include "analysis/pipeline.h"
 #include "render/abuffer.h"
 #include "tests/run_binary.h"
+#include "tests/temp_dir_test.h"
 #include "tests/test_util.h"
 
 namespace va {
@@ -26,18 +27,12 @@ namespace {
 namespace fs = std::filesystem;
 using testing_util::runBinary;
 
-class LimitsTest : public ::testing::Test {
+class LimitsTest : public testing_util::TempDirTest {
   protected:
-    void SetUp() override {
-        const auto *info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() / ("visaudit-limits-" + std::to_string(getpid()) + "-" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+    LimitsTest() : TempDirTest("limits") {}
+
     void write(const std::string &name, const std::string &text) { std::ofstream(dir_ / name, std::ios::binary) << text; }
     std::string path(const std::string &name) const { return (dir_ / name).string(); }
-    fs::path dir_;
 };
 
 // A process that refused its input before allocating stays near the program's own size: the peak
