@@ -129,8 +129,8 @@ struct TileGrid {
     size_t count() const { return size_t(cols * rows); }
 };
 
-// Setup and binning of triangles [t0, t1): the walk's steps 1-2 (box of centers, range, area,
-// depth plane, single-sided winding) once per triangle, then the triangle goes to every tile its
+// Setup and binning of triangles [t0, t1): the walk's steps 1-2 (setupTriangle, the depth plane,
+// single-sided winding) once per triangle, then the triangle goes to every tile its
 // box of centers meets. A triangle spanning several tiles is tested against each tile's part of its
 // box: when one edge has all four corner centers of that part outside, the tile is skipped
 // (whole-tile reject); when all three edges have all four inside, the tile is marked full (whole-
@@ -141,29 +141,18 @@ void binChunk(const ScreenTriangles &tris, size_t t0, size_t t1, const TileGrid 
     chunk.tiles.assign(g.count(), {});
     const int32_t *const xy = tris.xy.data();
     for (size_t t = t0; t < t1; ++t) {
-        const int32_t *v = xy + 6 * t;
-        int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
-        const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
-        const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
-        const int64_t bx0 = std::max<int64_t>(firstCenter(minX), 0), bx1 = std::min<int64_t>(lastCenter(maxX), g.width - 1);
-        const int64_t by0 = std::max<int64_t>(firstCenter(minY), 0), by1 = std::min<int64_t>(lastCenter(maxY), g.height - 1);
-        if (bx0 > bx1 || by0 > by1) continue;
-        if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed) continue;
-        const int64_t area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
-        if (area == 0) continue;
+        TriangleSetup ts;
+        if (!setupTriangle(xy + 6 * t, g.width, g.height, &ts)) continue;
         if (!tris.planes[tris.plane[t]].valid) continue;
-        if (singleSided && singleSided[tris.source[t]] && !(area < 0)) {
+        if (singleSided && singleSided[tris.source[t]] && !ts.frontWinding) {
             ++chunk.backWinding;
             continue;
         }
+        const int64_t bx0 = ts.bx0, bx1 = ts.bx1, by0 = ts.by0, by1 = ts.by1;
         const int64_t tx0 = bx0 >> g.shift, tx1 = bx1 >> g.shift, ty0 = by0 >> g.shift, ty1 = by1 >> g.shift;
         if (tx0 == tx1 && ty0 == ty1) {
             chunk.tiles[size_t(ty0 * g.cols + tx0)].push_back({uint32_t(t), 0, 0});
             continue;
-        }
-        if (area < 0) {
-            std::swap(x1, x2);
-            std::swap(y1, y2);
         }
         const uint32_t multi = uint32_t(chunk.multiCounts.size());
         chunk.multiCounts.push_back(0);
@@ -172,8 +161,9 @@ void binChunk(const ScreenTriangles &tris, size_t t0, size_t t1, const TileGrid 
                 const int64_t cx0 = std::max(bx0, tx << g.shift), cx1 = std::min(bx1, ((tx + 1) << g.shift) - 1);
                 const int64_t cy0 = std::max(by0, ty << g.shift), cy1 = std::min(by1, ((ty + 1) << g.shift) - 1);
                 const int64_t sx = cx0 * kSubpixelOne + kHalf, sy = cy0 * kSubpixelOne + kHalf;
-                const EdgeSetup edges[3] = {setupEdge(x1, y1, x2, y2, sx, sy), setupEdge(x2, y2, x0, y0, sx, sy),
-                                            setupEdge(x0, y0, x1, y1, sx, sy)};
+                const EdgeSetup edges[3] = {setupEdge(ts.x1, ts.y1, ts.x2, ts.y2, sx, sy),
+                                            setupEdge(ts.x2, ts.y2, ts.x0, ts.y0, sx, sy),
+                                            setupEdge(ts.x0, ts.y0, ts.x1, ts.y1, sx, sy)};
                 bool outside = false, inside = true;
                 for (const EdgeSetup &e : edges) {
                     const int64_t right = e.stepX * (cx1 - cx0), down = e.stepY * (cy1 - cy0);

@@ -241,6 +241,38 @@ inline void coverTriangle(int64_t x0, int64_t y0, int64_t x1, int64_t y1, int64_
     }
 }
 
+// Steps 1-2 of the walk for one triangle's fixed-point corners v[0..5] in a W x H viewport: false
+// when it cannot produce a fragment (its box of pixel centers is empty or outside the viewport, a
+// coordinate lies outside +-kMaxFixed -- a clip-stage contract violation -- or its snapped signed
+// area is zero); otherwise the corners with v1, v2 swapped when the winding is the front one (so
+// every triangle is walked with positive area), the box clamped to the viewport, the larger vertex
+// extent. Shared by the walk and the tiled path's binning, so both see the same triangles.
+struct TriangleSetup {
+    int64_t x0, y0, x1, y1, x2, y2;
+    int64_t bx0, bx1, by0, by1;
+    int64_t ext;
+    bool frontWinding;  // counter-clockwise as the viewer sees it: negative area before the swap
+};
+[[gnu::always_inline]] inline bool setupTriangle(const int32_t *v, int64_t W, int64_t H, TriangleSetup *s) {
+    int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
+    const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
+    const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
+    const int64_t bx0 = std::max<int64_t>(firstCenter(minX), 0), bx1 = std::min<int64_t>(lastCenter(maxX), W - 1);
+    const int64_t by0 = std::max<int64_t>(firstCenter(minY), 0), by1 = std::min<int64_t>(lastCenter(maxY), H - 1);
+    if (bx0 > bx1 || by0 > by1) return false;  // no center inside the box (or box outside the viewport)
+    if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed) return false;
+    // Orientation: twice the signed area; zero area draws nothing, negative (counter-clockwise as
+    // the viewer sees it: the front winding) is swapped so one inside test serves both.
+    const int64_t area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
+    if (area == 0) return false;
+    if (area < 0) {
+        std::swap(x1, x2);
+        std::swap(y1, y2);
+    }
+    *s = {x0, y0, x1, y1, x2, y2, bx0, bx1, by0, by1, std::max(maxX - minX, maxY - minY), area < 0};
+    return true;
+}
+
 // The walk for one projection (see the contract above; the steps per triangle):
 //   1. the bounding box of the *pixel centers* it may cover, clamped to the viewport; empty box ->
 //      done (the common case for the benchmark scene's sub-pixel triangles: no edge setup at all);
@@ -263,35 +295,17 @@ void walkFragments(const ScreenTriangles &tris, int width, int height, Sink &sin
     const DepthPlane *const planes = tris.planes.data();
     const size_t n = tris.size();
     for (size_t t = 0; t < n; ++t) {
-        const int32_t *v = xy + 6 * t;
-        int64_t x0 = v[0], y0 = v[1], x1 = v[2], y1 = v[3], x2 = v[4], y2 = v[5];
-
-        // Bounding box of the pixel centers it may cover, clamped to the viewport.
-        const int64_t minX = std::min(x0, std::min(x1, x2)), maxX = std::max(x0, std::max(x1, x2));
-        const int64_t minY = std::min(y0, std::min(y1, y2)), maxY = std::max(y0, std::max(y1, y2));
-        const int64_t bx0 = std::max<int64_t>(firstCenter(minX), 0), bx1 = std::min<int64_t>(lastCenter(maxX), W - 1);
-        const int64_t by0 = std::max<int64_t>(firstCenter(minY), 0), by1 = std::min<int64_t>(lastCenter(maxY), H - 1);
-        if (bx0 > bx1 || by0 > by1) continue;  // no center inside the box (or box outside the viewport)
-        if (minX < -kMaxFixed || maxX > kMaxFixed || minY < -kMaxFixed || maxY > kMaxFixed)
-            continue;  // outside the representable range (kMaxFixed): a clip-stage contract violation
-
-        // Orientation: twice the signed area; zero area draws nothing, negative (counter-clockwise
-        // as the viewer sees it: the front winding) is swapped so one inside test serves both.
-        const int64_t area = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
-        if (area == 0) continue;
-        if (area < 0) {
-            std::swap(x1, x2);
-            std::swap(y1, y2);
-        }
+        TriangleSetup ts;
+        if (!setupTriangle(xy + 6 * t, W, H, &ts)) continue;
         const DepthPlane plane = planes[planeIndex[t]];
         if (!plane.valid) continue;
-        if (!sink.beginTriangle(t, area < 0)) continue;
+        if (!sink.beginTriangle(t, ts.frontWinding)) continue;
 
         // One covered center: depth from the plane exactly as evalDepthPlane writes it
         // ((a*px + b*py) + c), then the sink.
         uint64_t triFragments = 0;
         const double pa = plane.a, pb = plane.b, pc = plane.c;
-        coverTriangle(x0, y0, x1, y1, x2, y2, std::max(maxX - minX, maxY - minY), bx0, bx1, by0, by1, size_t(W),
+        coverTriangle(ts.x0, ts.y0, ts.x1, ts.y1, ts.x2, ts.y2, ts.ext, ts.bx0, ts.bx1, ts.by0, ts.by1, size_t(W),
                       [&](size_t idx, int64_t x, int64_t y) {
                           const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
                           const double d = kPerspective ? 1.0 / pv : pv;
