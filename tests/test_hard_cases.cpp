@@ -51,15 +51,8 @@ ViewSpec orthoView(Vec3 eye = {0, 0, 10}) {
 
 // Perspective view from the origin along -z (up +y): view space is world space, exactly.
 ViewSpec axisView(int w, int h, double fov, double nearZ, double farZ) {
-    ViewSpec v;
+    ViewSpec v = viewOf({0, 0, 0}, {0, 0, -1}, w, h, fov, nearZ, farZ);
     v.name = "axis";
-    v.camera.eye = {0, 0, 0};
-    v.camera.target = {0, 0, -1};
-    v.camera.fovYDegrees = fov;
-    v.camera.nearZ = nearZ;
-    v.camera.farZ = farZ;
-    v.camera.width = w;
-    v.camera.height = h;
     return v;
 }
 

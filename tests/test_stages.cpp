@@ -15,20 +15,6 @@ using namespace va::testing_util;
 
 namespace {
 
-ViewSpec viewOf(Vec3 eye, Vec3 target, int w = 64, int h = 48, double fov = 60, double nearZ = 0.1,
-                double farZ = 100) {
-    ViewSpec v;
-    v.name = "v";
-    v.camera.eye = eye;
-    v.camera.target = target;
-    v.camera.fovYDegrees = fov;
-    v.camera.nearZ = nearZ;
-    v.camera.farZ = farZ;
-    v.camera.width = w;
-    v.camera.height = h;
-    return v;
-}
-
 // Settings with the frustum and backface stages off (clip and z-buffer only).
 PipelineSettings noCulling() {
     PipelineSettings s;

@@ -32,6 +32,21 @@ inline RawMesh triangleMesh(Vec3 a, Vec3 b, Vec3 c) {
     return m;
 }
 
+// A perspective view named "v" from `eye` towards `target` (up +y).
+inline ViewSpec viewOf(Vec3 eye, Vec3 target, int w = 64, int h = 48, double fov = 60, double nearZ = 0.1,
+                       double farZ = 100) {
+    ViewSpec v;
+    v.name = "v";
+    v.camera.eye = eye;
+    v.camera.target = target;
+    v.camera.fovYDegrees = fov;
+    v.camera.nearZ = nearZ;
+    v.camera.farZ = farZ;
+    v.camera.width = w;
+    v.camera.height = h;
+    return v;
+}
+
 // Loose triangles, one object each, named "t0", "t1", ...; one material.
 inline Scene looseTriangles(const std::vector<std::array<Vec3, 3>> &tris, bool doubleSided = false) {
     SceneBuildInput in;
