@@ -128,7 +128,7 @@ int main(int argc, char **argv) {
     using Path = va::RasterStrategy::Path;
     std::vector<Config> configs = {
         {"plain walk (reference)", 1, {Path::plainWalk, true, 0}},
-        {"default", 1, {}},
+        {"default (batched walk)", 1, {}},
         {"tiled, baseline SSE2", 1, {Path::tiled, false, 0}},
         {"tiled, AVX2 if present", 1, {Path::tiled, true, 0}},
         {"default", allThreads, {}},

@@ -35,84 +35,6 @@ int32_t toFixed(double pixelCoordinate) {
 
 namespace {
 
-// The z-buffer as a fragment sink (raster_core.h). Instantiated per depth format and projection
-// (dispatchDepthFormat once per call), so encodeDepth<F> inlines; kExact compares the double depth
-// instead (the format is then not used per fragment). Accumulators live in the sink and are added
-// to the stats once at the end.
-template <DepthFormat F, bool kExact>
-struct ZBufferSink {
-    const DepthEncoder &enc;
-    const uint32_t *source;           // ScreenTriangles::source
-    const uint8_t *singleSided;       // settings.singleSided (may be null)
-    uint32_t *fragmentsPerSource;     // settings.fragmentsPerSource (may be null)
-    uint32_t *keyBuf;
-    uint32_t *idBuf;
-    double *depthBuf;
-    uint16_t *fragBuf;
-    uint16_t *passBuf;
-    // 1 + source of the current triangle, held as uint64_t: a uint32_t member could alias the
-    // uint32_t buffers written per fragment, forcing a reload after every store.
-    uint64_t idValue = 0;
-    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawn = 0, backWinding = 0;
-
-    bool beginTriangle(size_t t, bool frontWinding) {
-        const uint32_t src = source[t];
-        if (singleSided && singleSided[src] && !frontWinding) {
-            ++backWinding;
-            return false;
-        }
-        idValue = src + 1;
-        return true;
-    }
-
-    [[gnu::always_inline]] void fragment(size_t idx, size_t, double d) {
-        fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
-        // LESS: on equal keys (or equal depths) the first drawn fragment stays. Written as selects,
-        // not a branch: about half the fragments pass, in no predictable pattern.
-        bool pass;
-        if constexpr (kExact) {
-            pass = d < depthBuf[idx];
-        } else {
-            uint32_t key;
-            bool oor = false;
-            encodeDepth<F>(enc, d, key, oor);
-            outOfRange += oor ? 1 : 0;
-            const uint32_t oldKey = keyBuf[idx];
-            pass = key < oldKey;
-            keyBuf[idx] = pass ? key : oldKey;
-        }
-        idBuf[idx] = pass ? uint32_t(idValue) : idBuf[idx];
-        depthBuf[idx] = pass ? d : depthBuf[idx];
-        passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
-        passes += pass ? 1 : 0;
-    }
-
-    void endTriangle(size_t t, uint64_t n) {
-        fragments += n;
-        drawn += n != 0 ? 1 : 0;
-        if (fragmentsPerSource) fragmentsPerSource[source[t]] += uint32_t(n);
-    }
-};
-
-template <DepthFormat F, bool kExact>
-void rasterizeWith(const ScreenTriangles &tris, const ZBufferSettings &settings, ZBuffer &zb, ZBufferStats &st) {
-    ZBufferSink<F, kExact> sink{settings.encoder,    tris.source.data(), settings.singleSided,
-                                settings.fragmentsPerSource, zb.key.data(), zb.id.data(),
-                                zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
-    forEachFragment(tris, zb.width, zb.height, settings.orthographic, sink);
-    st.fragments += sink.fragments;
-    st.depthPasses += sink.passes;
-    st.outOfRangeFragments += sink.outOfRange;
-    st.trianglesDrawn += sink.drawn;
-    st.trianglesEmpty += st.trianglesIn - sink.drawn;
-    st.trianglesBackWinding += sink.backWinding;
-    if constexpr (kExact) {
-        // The keys of the stored depths, so the buffer reads the same as a format-tested one.
-        for (size_t i = 0; i < zb.id.size(); ++i)
-            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
-    }
-}
-
 // ---- The tiled path (docs/rasterizer.md: Tiles) ----
 using namespace raster_detail;
 
@@ -257,6 +179,7 @@ namespace raster_detail {
 ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth) {
     return selectShade(format, perspective, exactDepth);
 }
+WalkFn walkFunctionBase(DepthFormat format, bool exactDepth) { return selectWalk<false>(format, exactDepth); }
 }  // namespace raster_detail
 
 ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings) {
@@ -280,17 +203,18 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
     ZBufferStats &st = r.stats;
     st.trianglesIn = tris.size();
     const int threads = availableThreads();
-    const bool tiled = strategy.path == RasterStrategy::Path::tiled ||
-                       (strategy.path == RasterStrategy::Path::automatic && threads > 1);
+    using Path = RasterStrategy::Path;
+    const bool tiled = strategy.path == Path::tiled || (strategy.path == Path::automatic && threads > 1);
     if (pixels > 0 && tiled) {
         rasterizeTiled(tris, settings, strategy, threads, zb, st);
     } else if (pixels > 0) {
-        if (settings.exactDepth) {
-            rasterizeWith<DepthFormat::f32, true>(tris, settings, zb, st);  // the format is not used per fragment
-        } else {
-            dispatchDepthFormat(settings.encoder.format,
-                                [&]<DepthFormat F>() { rasterizeWith<F, false>(tris, settings, zb, st); });
-        }
+        WalkFn walk = nullptr;
+#if defined(__x86_64__) || defined(__i386__)
+        if (strategy.path != Path::plainWalk && strategy.allowAvx2 && __builtin_cpu_supports("avx2"))
+            walk = walkFunctionAvx2(settings.encoder.format, settings.exactDepth);
+#endif
+        if (!walk) walk = walkFunctionBase(settings.encoder.format, settings.exactDepth);
+        walk(tris, settings, zb, st);
     } else {
         st.trianglesEmpty = tris.size();
     }

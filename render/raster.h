@@ -97,12 +97,14 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
 // the defaults are what the benchmark measured fastest, the others exist for tests and benchmarks.
 struct RasterStrategy {
     enum class Path : uint8_t {
-        automatic,  // plainWalk on one thread, tiled otherwise
+        automatic,  // batchedWalk on one thread, tiled otherwise
         plainWalk,  // the reference: one in-order walk through forEachFragment (raster_core.h)
+        batchedWalk,// the in-order walk setting up 8 triangles at once in AVX2 lanes (plainWalk without
+                    // AVX2 or allowAvx2)
         tiled,      // binned into tiles, each tile's triangles in submission order, tiles in parallel
     };
     Path path = Path::automatic;
-    bool allowAvx2 = true;  // tiled: the AVX2 kernel when the CPU has it (else the baseline SSE2 one)
+    bool allowAvx2 = true;  // tiled, batchedWalk: AVX2 code when the CPU has it (else the baseline SSE2 one)
     int tileShift = 0;      // tiled: tiles of 2^tileShift pixels square; 0 = default (kDefaultTileShift)
 };
 constexpr int kDefaultTileShift = 7;

@@ -11,6 +11,7 @@ namespace va::raster_detail {
 ShadeFn shadeFunctionAvx2(DepthFormat format, bool perspective, bool exactDepth) {
     return selectShade(format, perspective, exactDepth);
 }
+WalkFn walkFunctionAvx2(DepthFormat format, bool exactDepth) { return selectWalk<true>(format, exactDepth); }
 }  // namespace va::raster_detail
 #else
 #include "render/raster_kernel.h"
@@ -18,5 +19,6 @@ ShadeFn shadeFunctionAvx2(DepthFormat format, bool perspective, bool exactDepth)
 namespace va::raster_detail {
 // Built without -mavx2 (not an x86-64 compiler): no AVX2 kernel, the baseline one runs.
 ShadeFn shadeFunctionAvx2(DepthFormat, bool, bool) { return nullptr; }
+WalkFn walkFunctionAvx2(DepthFormat, bool) { return nullptr; }
 }  // namespace va::raster_detail
 #endif

@@ -75,11 +75,112 @@ struct TileCounts {
 };
 
 using ShadeFn = void (*)(const ShadeTarget &, const TileWork &, TileCounts &);
+// The in-order walk into a cleared z-buffer (rasterizeWalk below), adding to the stats.
+using WalkFn = void (*)(const ScreenTriangles &, const ZBufferSettings &, ZBuffer &, ZBufferStats &);
 // The kernel for a depth format, projection and exactDepth, per instruction set.
 ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth);
 ShadeFn shadeFunctionAvx2(DepthFormat format, bool perspective, bool exactDepth);
+// The walk for a depth format and exactDepth: the baseline one (walkFragments) and the AVX2 one
+// (walkFragmentsBatched; null when not built for x86-64).
+WalkFn walkFunctionBase(DepthFormat format, bool exactDepth);
+WalkFn walkFunctionAvx2(DepthFormat format, bool exactDepth);
 
 inline namespace VA_RASTER_ISA {
+
+// The z-buffer as a fragment sink (raster_core.h). Instantiated per depth format and projection
+// (dispatchDepthFormat once per call), so encodeDepth<F> inlines; kExact compares the double depth
+// instead (the format is then not used per fragment). Accumulators live in the sink and are added
+// to the stats once at the end.
+template <DepthFormat F, bool kExact>
+struct ZBufferSink {
+    const DepthEncoder &enc;
+    const uint32_t *source;           // ScreenTriangles::source
+    const uint8_t *singleSided;       // settings.singleSided (may be null)
+    uint32_t *fragmentsPerSource;     // settings.fragmentsPerSource (may be null)
+    uint32_t *keyBuf;
+    uint32_t *idBuf;
+    double *depthBuf;
+    uint16_t *fragBuf;
+    uint16_t *passBuf;
+    // 1 + source of the current triangle, held as uint64_t: a uint32_t member could alias the
+    // uint32_t buffers written per fragment, forcing a reload after every store.
+    uint64_t idValue = 0;
+    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawn = 0, backWinding = 0;
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const uint32_t src = source[t];
+        if (singleSided && singleSided[src] && !frontWinding) {
+            ++backWinding;
+            return false;
+        }
+        idValue = src + 1;
+        return true;
+    }
+
+    [[gnu::always_inline]] void fragment(size_t idx, size_t, double d) {
+        fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
+        // LESS: on equal keys (or equal depths) the first drawn fragment stays. Written as selects,
+        // not a branch: about half the fragments pass, in no predictable pattern.
+        bool pass;
+        if constexpr (kExact) {
+            pass = d < depthBuf[idx];
+        } else {
+            uint32_t key;
+            bool oor = false;
+            encodeDepth<F>(enc, d, key, oor);
+            outOfRange += oor ? 1 : 0;
+            const uint32_t oldKey = keyBuf[idx];
+            pass = key < oldKey;
+            keyBuf[idx] = pass ? key : oldKey;
+        }
+        idBuf[idx] = pass ? uint32_t(idValue) : idBuf[idx];
+        depthBuf[idx] = pass ? d : depthBuf[idx];
+        passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
+        passes += pass ? 1 : 0;
+    }
+
+    void endTriangle(size_t t, uint64_t n) {
+        fragments += n;
+        drawn += n != 0 ? 1 : 0;
+        if (fragmentsPerSource) fragmentsPerSource[source[t]] += uint32_t(n);
+    }
+};
+
+// The in-order walk into the z-buffer: walkFragments, or with kBatched (AVX2 builds only)
+// walkFragmentsBatched, which gives the same fragments in the same triangle order.
+template <DepthFormat F, bool kExact, bool kBatched>
+void rasterizeWalk(const ScreenTriangles &tris, const ZBufferSettings &settings, ZBuffer &zb, ZBufferStats &st) {
+    ZBufferSink<F, kExact> sink{settings.encoder,    tris.source.data(), settings.singleSided,
+                                settings.fragmentsPerSource, zb.key.data(), zb.id.data(),
+                                zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
+    if constexpr (kBatched) {
+#if defined(__AVX2__)
+        if (settings.orthographic) walkFragmentsBatched<false>(tris, zb.width, zb.height, sink);
+        else walkFragmentsBatched<true>(tris, zb.width, zb.height, sink);
+#endif
+    } else {
+        if (settings.orthographic) walkFragments<false>(tris, zb.width, zb.height, sink);
+        else walkFragments<true>(tris, zb.width, zb.height, sink);
+    }
+    st.fragments += sink.fragments;
+    st.depthPasses += sink.passes;
+    st.outOfRangeFragments += sink.outOfRange;
+    st.trianglesDrawn += sink.drawn;
+    st.trianglesEmpty += st.trianglesIn - sink.drawn;
+    st.trianglesBackWinding += sink.backWinding;
+    if constexpr (kExact) {
+        // The keys of the stored depths, so the buffer reads the same as a format-tested one.
+        for (size_t i = 0; i < zb.id.size(); ++i)
+            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
+    }
+}
+
+
+template <bool kBatched>
+inline WalkFn selectWalk(DepthFormat format, bool exactDepth) {
+    if (exactDepth) return &rasterizeWalk<DepthFormat::f32, true, kBatched>;  // the format is not used per fragment
+    return dispatchDepthFormat(format, [&]<DepthFormat F>() -> WalkFn { return &rasterizeWalk<F, false, kBatched>; });
+}
 
 constexpr size_t kBatch = 256;
 

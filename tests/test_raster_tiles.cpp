@@ -44,7 +44,7 @@ ScreenTriangles tileSoup(uint32_t seed, int W, int H, int count, bool ortho) {
     };
     const double pad = 8192 - 16;  // within the clipper's guard band
     while (int(tris.size()) < count) {
-        const int cls = int(rng() % 16);
+        const int cls = int(rng() % 18);
         const double cx = uni(-20, W + 20), cy = uni(-20, H + 20);
         if (cls == 0) {  // guard-band sized: covers the viewport and beyond
             add(uni(-pad, 0), uni(-pad, 0), uni(W, W + pad), uni(-pad, H), uni(-pad, W + pad), uni(H, H + pad));
@@ -69,6 +69,13 @@ ScreenTriangles tileSoup(uint32_t seed, int W, int H, int count, bool ortho) {
             const bool off = rng() % 2;
             const double ox = off ? -W - 100 : cx;
             add(ox, cy, ox + 5, cy + 3, ox + 10, cy + 6);
+        } else if (cls == 16) {  // a corner beyond the rasterizer's range (kMaxFixed), or NaN: skipped
+            const double far = rng() % 2 ? uni(2.2e6, 8e6) : std::nan("");
+            add(cx, cy, cx + 3, cy + 1, rng() % 2 ? far : -far, cy + 2);
+        } else if (cls == 17) {  // long (up to ~80 px) but clamped by the viewport to a box of a few centers
+            const double ex = uni(40, 80), ey = uni(0.5, 4);
+            const double x = rng() % 2 ? uni(-ex, -ex + 4) : uni(W - 4, W), y = uni(-2, H);
+            add(x, y, x + ex, y + uni(-ey, ey), x + uni(0, ex), y + ey);
         } else {  // sizes from sub-pixel to a few tiles
             const double r = cls < 8 ? uni(0.1, 1.5) : cls < 12 ? uni(1.5, 9) : cls < 15 ? uni(9, 70) : uni(70, 400);
             add(cx + uni(-r, r), cy + uni(-r, r), cx + uni(-r, r), cy + uni(-r, r), cx + uni(-r, r), cy + uni(-r, r));
@@ -131,6 +138,9 @@ TEST(RasterTiles, RandomSoupsAllFormatsMatchPlainWalk) {
                         expectIdentical(rasterizeOn(threads, tris, W, H, s, {Path::tiled, avx2, shift}), want,
                                         name + " tiles " + std::to_string(1 << shift) + (avx2 ? " avx2 " : " base ") +
                                             std::to_string(threads) + " threads");
+            for (bool avx2 : {true, false})
+                expectIdentical(rasterizeOn(1, tris, W, H, s, {Path::batchedWalk, avx2, 0}), want,
+                                name + (avx2 ? " batched walk avx2" : " batched walk base"));
             for (int threads : {1, 2, 8})
                 expectIdentical(rasterizeOn(threads, tris, W, H, s, {}), want,
                                 name + " default " + std::to_string(threads) + " threads");
@@ -157,6 +167,14 @@ TEST(RasterTiles, OptionsMatchPlainWalk) {
             const ZBufferResult want = rasterizeOn(1, tris, W, H, s, {Path::plainWalk, true, 0});
             if (oneSided) {
                 EXPECT_GT(want.stats.trianglesBackWinding, 1000u);
+            }
+            {
+                std::vector<uint32_t> perSource(sources, 0);
+                s.fragmentsPerSource = perSource.data();
+                const std::string what = std::string(exact ? "exact" : "keyed") + (oneSided ? " single-sided" : "") +
+                                         " batched walk";
+                expectIdentical(rasterizeOn(1, tris, W, H, s, {Path::batchedWalk, true, 0}), want, what);
+                EXPECT_TRUE(perSource == wantPerSource) << what;
             }
             for (int shift : {4, 7})
                 for (int threads : {1, 2, 8}) {
@@ -186,6 +204,7 @@ TEST(RasterTiles, BenchSceneMatchesPlainWalk) {
     const ZBufferResult want = rasterizeOn(1, clip.out, cam.width, cam.height, s, {Path::plainWalk, true, 0});
     EXPECT_EQ(want.stats.trianglesIn, 1000002u);
     expectIdentical(rasterizeOn(2, clip.out, cam.width, cam.height, s, {}), want, "bench scene, default, 2 threads");
+    expectIdentical(rasterizeOn(1, clip.out, cam.width, cam.height, s, {}), want, "bench scene, default, 1 thread");
 }
 
 }  // namespace
