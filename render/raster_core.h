@@ -26,7 +26,10 @@
 //     made for it (possibly 0: a sub-pixel triangle between centers).
 //   Coverage is the top-left fill rule on pixel centers in fixed point (kSubpixelBits), exactly;
 //   the three coverage paths (small SIMD block, per-row span, box scan) give the same set.
-// The sink is a template parameter, so its calls inline: a sink costs what its body costs.
+// The sink is a template parameter, so its calls inline: a sink costs what its body costs. A sink
+// declaring `static constexpr bool kPlaneValue = true` receives, instead of d, the plane value v
+// (d = 1 / v in perspective, v itself orthographically) and computes d itself, with the same IEEE
+// operation (the z-buffer does it for a batch of fragments in SIMD lanes: raster_kernel.h).
 #pragma once
 
 #include <algorithm>
@@ -288,6 +291,13 @@ struct TriangleSetup {
 //        so large triangles cost per row, not per empty center of their box;
 //      - otherwise: every center of the box, stepping the edge functions;
 //   5. per covered center: view depth straight from the DepthPlane, then sink.fragment.
+// The fragment call of the contract above: v is the plane value at the center.
+template <bool kPerspective, class Sink>
+[[gnu::always_inline]] inline void emitFragment(Sink &sink, size_t idx, size_t t, double v) {
+    if constexpr (requires { Sink::kPlaneValue; }) sink.fragment(idx, t, v);
+    else sink.fragment(idx, t, kPerspective ? 1.0 / v : v);
+}
+
 // Steps 2-5 of the walk below for triangle t, whose step 1 (setupTriangle) gave ts.
 template <bool kPerspective, class Sink>
 [[gnu::always_inline]] inline void walkSetUpTriangle(const ScreenTriangles &tris, size_t t, const TriangleSetup &ts,
@@ -303,9 +313,8 @@ template <bool kPerspective, class Sink>
     coverTriangle(ts.x0, ts.y0, ts.x1, ts.y1, ts.x2, ts.y2, ts.ext, ts.bx0, ts.bx1, ts.by0, ts.by1, W,
                   [&](size_t idx, int64_t x, int64_t y) {
                       const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
-                      const double d = kPerspective ? 1.0 / pv : pv;
                       ++triFragments;
-                      sink.fragment(idx, t, d);
+                      emitFragment<kPerspective>(sink, idx, t, pv);
                   });
     sink.endTriangle(t, triFragments);
 }
@@ -475,9 +484,8 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
                 mask &= mask - 1;
                 const size_t x = x0l + size_t(bit & 3), y = y0l + size_t(bit >> 2);
                 const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
-                const double d = kPerspective ? 1.0 / pv : pv;
                 ++triFragments;
-                sink.fragment(y * size_t(W) + x, tl, d);
+                emitFragment<kPerspective>(sink, y * size_t(W) + x, tl, pv);
             }
             sink.endTriangle(tl, triFragments);
         }

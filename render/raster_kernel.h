@@ -19,6 +19,7 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
 #include <cstddef>
 #include <cstdint>
 
@@ -86,6 +87,114 @@ WalkFn walkFunctionBase(DepthFormat format, bool exactDepth);
 WalkFn walkFunctionAvx2(DepthFormat format, bool exactDepth);
 
 inline namespace VA_RASTER_ISA {
+
+constexpr size_t kBatch = 256;
+
+// Fragments collected for the z-buffer and resolved kBatch at a time (steps 1-3 of the header
+// comment): push() takes a covered center's pixel, plane value and id and fetches the pixel's five
+// buffer lines; flush() computes the view depths and keys of the whole batch in branch-free loops
+// (SIMD lanes), then runs the LESS tests and writes in push order.
+template <DepthFormat F, bool kPerspective, bool kExact>
+struct FragmentBatch {
+    alignas(64) double value[kBatch];  // plane value, then view depth
+    alignas(64) uint32_t keys[kBatch];
+    alignas(64) uint32_t pixel[kBatch];
+    alignas(64) uint32_t ids[kBatch];
+    size_t n = 0;
+    uint64_t passes = 0, outOfRange = 0;
+    DepthEncoder enc;  // a copy: loads through a pointer keep GCC from vectorizing the encode loop
+    uint32_t *keyBuf, *idBuf;
+    double *depthBuf;
+    uint16_t *fragBuf, *passBuf;
+
+    FragmentBatch(const DepthEncoder &encoder, uint32_t *key, uint32_t *id, double *depth, uint16_t *fragments,
+                  uint16_t *passes_)
+        : enc(encoder), keyBuf(key), idBuf(id), depthBuf(depth), fragBuf(fragments), passBuf(passes_) {}
+
+    [[gnu::always_inline]] void push(size_t idx, double planeValue, uint32_t id) {
+        // The flush reads and writes these kBatch fragments later: fetch their lines now.
+        __builtin_prefetch(keyBuf + idx, 1);
+        __builtin_prefetch(idBuf + idx, 1);
+        __builtin_prefetch(depthBuf + idx, 1);
+        __builtin_prefetch(fragBuf + idx, 1);
+        __builtin_prefetch(passBuf + idx, 1);
+        value[n] = planeValue;
+        pixel[n] = uint32_t(idx);
+        ids[n] = id;
+        if (++n == kBatch) flush();
+    }
+
+    void flush() {
+        if constexpr (kPerspective)
+            for (size_t i = 0; i < n; ++i) value[i] = 1.0 / value[i];
+        if constexpr (!kExact) {
+            const DepthEncoder e = enc;
+            uint32_t oor = 0;
+            for (size_t i = 0; i < n; ++i) {
+                bool o = false;
+                uint32_t k;
+                encodeDepth<F>(e, value[i], k, o);
+                keys[i] = k;
+                oor += o ? 1 : 0;
+            }
+            outOfRange += oor;
+        }
+        uint32_t *const kb = keyBuf, *const ib = idBuf;
+        uint16_t *const pb = passBuf, *const fb = fragBuf;
+        double *const db = depthBuf;
+        uint64_t p = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const size_t idx = pixel[i];
+            const double d = value[i];
+            fb[idx] += fb[idx] != 0xFFFF ? 1 : 0;
+            // LESS: on equal keys (or equal depths) the first drawn fragment stays; selects, not a
+            // branch (about half the fragments pass, in no predictable pattern).
+            bool pass;
+            if constexpr (kExact) {
+                pass = d < db[idx];
+            } else {
+                const uint32_t oldKey = kb[idx];
+                pass = keys[i] < oldKey;
+                kb[idx] = pass ? keys[i] : oldKey;
+            }
+            ib[idx] = pass ? ids[i] : ib[idx];
+            db[idx] = pass ? d : db[idx];
+            pb[idx] += (pass && pb[idx] != 0xFFFF) ? 1 : 0;
+            p += pass ? 1 : 0;
+        }
+        passes += p;
+        n = 0;
+    }
+};
+
+// The batched walk's z-buffer sink: ZBufferSink's counts, fragments through a FragmentBatch
+// (kPlaneValue: the walk hands over plane values, the batch divides).
+template <DepthFormat F, bool kPerspective, bool kExact>
+struct ZBufferBatchSink {
+    static constexpr bool kPlaneValue = true;
+    const uint32_t *source;
+    const uint8_t *singleSided;
+    uint32_t *fragmentsPerSource;
+    FragmentBatch<F, kPerspective, kExact> &batch;
+    uint32_t idValue = 0;
+    uint64_t fragments = 0, drawn = 0, backWinding = 0;
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const uint32_t src = source[t];
+        if (singleSided && singleSided[src] && !frontWinding) {
+            ++backWinding;
+            return false;
+        }
+        idValue = src + 1;
+        return true;
+    }
+    [[gnu::always_inline]] void fragment(size_t idx, size_t, double planeValue) { batch.push(idx, planeValue, idValue); }
+    void endTriangle(size_t t, uint64_t n) {
+        fragments += n;
+        drawn += n != 0 ? 1 : 0;
+        if (fragmentsPerSource) fragmentsPerSource[source[t]] += uint32_t(n);
+    }
+};
 
 // The z-buffer as a fragment sink (raster_core.h). Instantiated per depth format and projection
 // (dispatchDepthFormat once per call), so encodeDepth<F> inlines; kExact compares the double depth
@@ -155,8 +264,21 @@ void rasterizeWalk(const ScreenTriangles &tris, const ZBufferSettings &settings,
                                 zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
     if constexpr (kBatched) {
 #if defined(__AVX2__)
-        if (settings.orthographic) walkFragmentsBatched<false>(tris, zb.width, zb.height, sink);
-        else walkFragmentsBatched<true>(tris, zb.width, zb.height, sink);
+        auto run = [&]<bool kPerspective>() {
+            auto batch = std::make_unique<FragmentBatch<F, kPerspective, kExact>>(
+                settings.encoder, zb.key.data(), zb.id.data(), zb.depth.data(), zb.fragments.data(), zb.passes.data());
+            ZBufferBatchSink<F, kPerspective, kExact> bs{tris.source.data(), settings.singleSided,
+                                                         settings.fragmentsPerSource, *batch};
+            walkFragmentsBatched<kPerspective>(tris, zb.width, zb.height, bs);
+            batch->flush();
+            sink.fragments = bs.fragments;
+            sink.drawn = bs.drawn;
+            sink.backWinding = bs.backWinding;
+            sink.passes = batch->passes;
+            sink.outOfRange = batch->outOfRange;
+        };
+        if (settings.orthographic) run.template operator()<false>();
+        else run.template operator()<true>();
 #endif
     } else {
         if (settings.orthographic) walkFragments<false>(tris, zb.width, zb.height, sink);
@@ -182,62 +304,9 @@ inline WalkFn selectWalk(DepthFormat format, bool exactDepth) {
     return dispatchDepthFormat(format, [&]<DepthFormat F>() -> WalkFn { return &rasterizeWalk<F, false, kBatched>; });
 }
 
-constexpr size_t kBatch = 256;
-
 template <DepthFormat F, bool kPerspective, bool kExact>
 void shadeTile(const ShadeTarget &s, const TileWork &w, TileCounts &counts) {
-    alignas(64) double value[kBatch];  // plane value, then view depth
-    alignas(64) uint32_t keys[kBatch];
-    alignas(64) uint32_t pixel[kBatch];
-    alignas(64) uint32_t ids[kBatch];
-    size_t n = 0;
-    uint64_t passes = 0, outOfRange = 0;
-
-    // Steps 2 and 3 of the header comment for the n fragments collected so far.
-    auto flush = [&] {
-        if constexpr (kPerspective)
-            for (size_t i = 0; i < n; ++i) value[i] = 1.0 / value[i];
-        if constexpr (!kExact) {
-            // A local copy of the encoder: loads through s.encoder inside the loop keep GCC from
-            // vectorizing it (it cannot prove the key stores leave the encoder alone).
-            const DepthEncoder enc = *s.encoder;
-            uint32_t oor = 0;
-            for (size_t i = 0; i < n; ++i) {
-                bool o = false;
-                uint32_t k;
-                encodeDepth<F>(enc, value[i], k, o);
-                keys[i] = k;
-                oor += o ? 1 : 0;
-            }
-            outOfRange += oor;
-        }
-        uint32_t *const keyBuf = s.key, *const idBuf = s.id;
-        uint16_t *const passBuf = s.passes, *const fragBuf = s.fragments;
-        double *const depthBuf = s.depth;
-        uint64_t p = 0;
-        for (size_t i = 0; i < n; ++i) {
-            const size_t idx = pixel[i];
-            const double d = value[i];
-            fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
-            // LESS: on equal keys (or equal depths) the first drawn fragment stays; selects, not a
-            // branch (about half the fragments pass, in no predictable pattern).
-            bool pass;
-            if constexpr (kExact) {
-                pass = d < depthBuf[idx];
-            } else {
-                const uint32_t oldKey = keyBuf[idx];
-                pass = keys[i] < oldKey;
-                keyBuf[idx] = pass ? keys[i] : oldKey;
-            }
-            idBuf[idx] = pass ? ids[i] : idBuf[idx];
-            depthBuf[idx] = pass ? d : depthBuf[idx];
-            passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
-            p += pass ? 1 : 0;
-        }
-        passes += p;
-        n = 0;
-    };
-
+    FragmentBatch<F, kPerspective, kExact> batch(*s.encoder, s.key, s.id, s.depth, s.fragments, s.passes);
     const size_t W = s.width;
     uint64_t fragments = 0, drawnSingle = 0;
     for (size_t l = 0; l < w.listCount; ++l) {
@@ -262,17 +331,8 @@ void shadeTile(const ShadeTarget &s, const TileWork &w, TileCounts &counts) {
             const uint32_t idValue = s.source[t] + 1;
             uint64_t triFragments = 0;
             auto frag = [&](size_t idx, int64_t x, int64_t y) {
-                // The flush reads and writes these kBatch fragments later: fetch their lines now.
-                __builtin_prefetch(s.key + idx, 1);
-                __builtin_prefetch(s.id + idx, 1);
-                __builtin_prefetch(s.depth + idx, 1);
-                __builtin_prefetch(s.fragments + idx, 1);
-                __builtin_prefetch(s.passes + idx, 1);
-                value[n] = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
-                pixel[n] = uint32_t(idx);
-                ids[n] = idValue;
                 ++triFragments;
-                if (++n == kBatch) flush();
+                batch.push(idx, (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc, idValue);
             };
             if (e.flags & kFullTile) {
                 for (int64_t y = by0; y <= by1; ++y)
@@ -298,10 +358,10 @@ void shadeTile(const ShadeTarget &s, const TileWork &w, TileCounts &counts) {
             }
         }
     }
-    flush();
+    batch.flush();
     counts.fragments += fragments;
-    counts.passes += passes;
-    counts.outOfRange += outOfRange;
+    counts.passes += batch.passes;
+    counts.outOfRange += batch.outOfRange;
     counts.drawnSingle += drawnSingle;
 }
 
