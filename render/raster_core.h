@@ -370,7 +370,6 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
         if (setupTriangle(xy + 6 * t, W, H, &ts)) walkSetUpTriangle<kPerspective>(tris, t, ts, size_t(W), sink);
     };
 
-    const __m256i gatherIndex = _mm256_setr_epi32(0, 6, 12, 18, 24, 30, 36, 42);
     const __m256i zero = _mm256_setzero_si256(), ones = _mm256_set1_epi32(-1);
     const __m256i lo = _mm256_set1_epi32(int32_t(-kMaxFixed - 1)), hi = _mm256_set1_epi32(int32_t(kMaxFixed + 1));
     const __m256i lastX = _mm256_set1_epi32(int32_t(W - 1)), lastY = _mm256_set1_epi32(int32_t(H - 1));
@@ -382,12 +381,21 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
     size_t t = 0;
     for (; t + 8 <= n; t += 8) {
         const int *base = xy + 6 * t;
-        const __m256i x0 = _mm256_i32gather_epi32(base + 0, gatherIndex, 4);
-        const __m256i y0 = _mm256_i32gather_epi32(base + 1, gatherIndex, 4);
-        __m256i x1 = _mm256_i32gather_epi32(base + 2, gatherIndex, 4);
-        __m256i y1 = _mm256_i32gather_epi32(base + 3, gatherIndex, 4);
-        __m256i x2 = _mm256_i32gather_epi32(base + 4, gatherIndex, 4);
-        __m256i y2 = _mm256_i32gather_epi32(base + 5, gatherIndex, 4);
+        // Corners of the 8 triangles into lanes (a 4 x 4 transpose in each 128-bit half: triangle k
+        // in lane k): per triangle k (and k + 4 in the upper half) the words x0 y0 x1 y1 and x1 y1 x2 y2.
+        auto pair = [&](int k, int offset) {
+            return _mm256_inserti128_si256(
+                _mm256_castsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i *>(base + 6 * k + offset))),
+                _mm_loadu_si128(reinterpret_cast<const __m128i *>(base + 6 * (k + 4) + offset)), 1);
+        };
+        const __m256i a0 = pair(0, 0), a1 = pair(1, 0), a2 = pair(2, 0), a3 = pair(3, 0);
+        const __m256i b0 = pair(0, 2), b1 = pair(1, 2), b2 = pair(2, 2), b3 = pair(3, 2);
+        const __m256i a01 = _mm256_unpacklo_epi32(a0, a1), a23 = _mm256_unpacklo_epi32(a2, a3);  // x0 x0 y0 y0
+        const __m256i c01 = _mm256_unpackhi_epi32(a0, a1), c23 = _mm256_unpackhi_epi32(a2, a3);  // x1 x1 y1 y1
+        const __m256i d01 = _mm256_unpackhi_epi32(b0, b1), d23 = _mm256_unpackhi_epi32(b2, b3);  // x2 x2 y2 y2
+        const __m256i x0 = _mm256_unpacklo_epi64(a01, a23), y0 = _mm256_unpackhi_epi64(a01, a23);
+        __m256i x1 = _mm256_unpacklo_epi64(c01, c23), y1 = _mm256_unpackhi_epi64(c01, c23);
+        __m256i x2 = _mm256_unpacklo_epi64(d01, d23), y2 = _mm256_unpackhi_epi64(d01, d23);
         const __m256i minX = _mm256_min_epi32(x0, _mm256_min_epi32(x1, x2));
         const __m256i maxX = _mm256_max_epi32(x0, _mm256_max_epi32(x1, x2));
         const __m256i minY = _mm256_min_epi32(y0, _mm256_min_epi32(y1, y2));
