@@ -377,10 +377,15 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
     const __m256i half = _mm256_set1_epi32(int32_t(kHalf));
     const __m256i rowPattern = _mm256_set1_epi32(0x1111);
     alignas(32) int32_t cover[8], boxX[8], boxY[8];
+    constexpr size_t kPlaneAhead = 64;
 
     size_t t = 0;
     for (; t + 8 <= n; t += 8) {
         const int *base = xy + 6 * t;
+        // The depth planes of the triangles kPlaneAhead later (their index is a dependent load that
+        // the hardware prefetcher does not follow): four lines, two planes each when consecutive.
+        if (t + kPlaneAhead + 8 <= n)
+            for (size_t k = 0; k < 8; k += 2) __builtin_prefetch(planes + planeIndex[t + kPlaneAhead + k]);
         // Corners of the 8 triangles into lanes (a 4 x 4 transpose in each 128-bit half: triangle k
         // in lane k): per triangle k (and k + 4 in the upper half) the words x0 y0 x1 y1 and x1 y1 x2 y2.
         auto pair = [&](int k, int offset) {
