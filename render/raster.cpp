@@ -204,17 +204,50 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
     st.trianglesIn = tris.size();
     const int threads = availableThreads();
     using Path = RasterStrategy::Path;
-    const bool tiled = strategy.path == Path::tiled || (strategy.path == Path::automatic && threads > 1);
+    WalkFn batched = nullptr;  // the AVX2 batched walk, when allowed and the CPU has it
+#if defined(__x86_64__) || defined(__i386__)
+    if (strategy.allowAvx2 && __builtin_cpu_supports("avx2"))
+        batched = walkFunctionAvx2(settings.encoder.format, settings.exactDepth);
+#endif
+    const bool tiled =
+        strategy.path == Path::tiled || (strategy.path == Path::automatic && threads > 1 && !batched);
     if (pixels > 0 && tiled) {
         rasterizeTiled(tris, settings, strategy, threads, zb, st);
     } else if (pixels > 0) {
-        WalkFn walk = nullptr;
-#if defined(__x86_64__) || defined(__i386__)
-        if (strategy.path != Path::plainWalk && strategy.allowAvx2 && __builtin_cpu_supports("avx2"))
-            walk = walkFunctionAvx2(settings.encoder.format, settings.exactDepth);
-#endif
+        WalkFn walk = strategy.path != Path::plainWalk ? batched : nullptr;
+        // Bands of rows in parallel (batched walk only): a few per thread, so uneven bands even out.
+        int bands = 1;
+        if (walk && (strategy.path == Path::automatic || strategy.path == Path::batchedWalk))
+            bands = strategy.bands > 0 ? strategy.bands : threads > 1 ? kBandsPerThread * threads : 1;
+        bands = std::clamp(bands, 1, zb.height);
         if (!walk) walk = walkFunctionBase(settings.encoder.format, settings.exactDepth);
-        walk(tris, settings, zb, st);
+        std::vector<WalkCounts> counts(static_cast<size_t>(bands));
+        std::vector<uint8_t> sharedDrawn(bands > 1 ? tris.size() : 0, uint8_t(0));
+        auto runBand = [&](size_t b) {
+            const WalkBand band{int(int64_t(zb.height) * int64_t(b) / bands),
+                                int(int64_t(zb.height) * int64_t(b + 1) / bands),
+                                bands > 1 ? sharedDrawn.data() : nullptr, bands > 1 && threads > 1};
+            walk(tris, settings, zb, band, counts[b]);
+        };
+        if (bands > 1 && threads > 1) tbb::parallel_for(size_t(0), size_t(bands), runBand);
+        else for (size_t b = 0; b < size_t(bands); ++b) runBand(b);
+        // Integer sums: the same in any order, so the same for any band count and thread count.
+        uint64_t drawn = 0;
+        for (const WalkCounts &c : counts) {
+            st.fragments += c.fragments;
+            st.depthPasses += c.passes;
+            st.outOfRangeFragments += c.outOfRange;
+            st.trianglesBackWinding += c.backWinding;
+            drawn += c.drawn;
+        }
+        for (uint8_t d : sharedDrawn) drawn += d;
+        st.trianglesDrawn += drawn;
+        st.trianglesEmpty += st.trianglesIn - drawn;
+        if (settings.exactDepth) {
+            // The keys of the stored depths, so the buffer reads the same as a format-tested one.
+            for (size_t i = 0; i < zb.id.size(); ++i)
+                if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
+        }
     } else {
         st.trianglesEmpty = tris.size();
     }

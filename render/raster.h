@@ -97,7 +97,7 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
 // the defaults are what the benchmark measured fastest, the others exist for tests and benchmarks.
 struct RasterStrategy {
     enum class Path : uint8_t {
-        automatic,  // batchedWalk on one thread, tiled otherwise
+        automatic,  // batchedWalk (in bands when threads > 1); without AVX2: plainWalk / tiled
         plainWalk,  // the reference: one in-order walk through forEachFragment (raster_core.h)
         batchedWalk,// the in-order walk setting up 8 triangles at once in AVX2 lanes (plainWalk without
                     // AVX2 or allowAvx2)
@@ -106,8 +106,11 @@ struct RasterStrategy {
     Path path = Path::automatic;
     bool allowAvx2 = true;  // tiled, batchedWalk: AVX2 code when the CPU has it (else the baseline SSE2 one)
     int tileShift = 0;      // tiled: tiles of 2^tileShift pixels square; 0 = default (kDefaultTileShift)
+    int bands = 0;          // batchedWalk: bands of rows (run in parallel when threads > 1);
+                            // 0 = one on one thread, kBandsPerThread per thread otherwise
 };
 constexpr int kDefaultTileShift = 7;
+constexpr int kBandsPerThread = 1;
 ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings,
                         const RasterStrategy &strategy);
 

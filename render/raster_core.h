@@ -357,34 +357,50 @@ void walkFragments(const ScreenTriangles &tris, int width, int height, Sink &sin
 // (setupTriangle, walkSetUpTriangle). Same contract and the same fragments as walkFragments: the
 // lanes compute the same integers (all exact, no overflow within the bounds above) and a triangle
 // the lanes find empty (box, range, zero area) is one setupTriangle rejects.
+//
+// Bands: only the rows [rowBegin, rowEnd) are walked (every box is clamped to them), so bands of
+// one viewport can run concurrently, each in submission order. Before each triangle's
+// beginTriangle, sink.band(home, shared) says whether the band holds the first row of the
+// triangle's box (home: count the triangle once) and whether its box reaches beyond the band
+// (shared: whether it drew anything is known only over all bands).
 template <bool kPerspective, class Sink>
-void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Sink &sink) {
+void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, int rowBegin, int rowEnd, Sink &sink) {
     const int64_t W = width, H = height;
-    if (W <= 0 || H <= 0) return;
+    if (W <= 0 || H <= 0 || rowBegin >= rowEnd) return;
     const int32_t *const xy = tris.xy.data();
     const uint32_t *const planeIndex = tris.plane.data();
     const DepthPlane *const planes = tris.planes.data();
     const size_t n = tris.size();
     auto scalar = [&](size_t t) {
         TriangleSetup ts;
-        if (setupTriangle(xy + 6 * t, W, H, &ts)) walkSetUpTriangle<kPerspective>(tris, t, ts, size_t(W), sink);
+        if (!setupTriangle(xy + 6 * t, W, H, &ts)) return;
+        const bool home = ts.by0 >= rowBegin, shared = ts.by0 < rowBegin || ts.by1 >= rowEnd;
+        ts.by0 = std::max<int64_t>(ts.by0, rowBegin);
+        ts.by1 = std::min<int64_t>(ts.by1, rowEnd - 1);
+        if (ts.by0 > ts.by1) return;
+        sink.band(home, shared);
+        walkSetUpTriangle<kPerspective>(tris, t, ts, size_t(W), sink);
     };
 
     const __m256i zero = _mm256_setzero_si256(), ones = _mm256_set1_epi32(-1);
     const __m256i lo = _mm256_set1_epi32(int32_t(-kMaxFixed - 1)), hi = _mm256_set1_epi32(int32_t(kMaxFixed + 1));
     const __m256i lastX = _mm256_set1_epi32(int32_t(W - 1)), lastY = _mm256_set1_epi32(int32_t(H - 1));
+    const __m256i bandFirst = _mm256_set1_epi32(rowBegin), bandLast = _mm256_set1_epi32(rowEnd - 1);
     const __m256i three = _mm256_set1_epi32(3), extLimit = _mm256_set1_epi32(int32_t(kBlockExtent));
     const __m256i half = _mm256_set1_epi32(int32_t(kHalf));
     const __m256i rowPattern = _mm256_set1_epi32(0x1111);
     alignas(32) int32_t cover[8], boxX[8], boxY[8];
     constexpr size_t kPlaneAhead = 64;
+    bool drawing = true;
 
     size_t t = 0;
     for (; t + 8 <= n; t += 8) {
         const int *base = xy + 6 * t;
         // The depth planes of the triangles kPlaneAhead later (their index is a dependent load that
         // the hardware prefetcher does not follow): four lines, two planes each when consecutive.
-        if (t + kPlaneAhead + 8 <= n)
+        // Only while the walk is drawing (the last group had a lane to draw): consecutive triangles
+        // are mostly neighbours, and a band skips most groups of a mesh drawn elsewhere.
+        if (drawing && t + kPlaneAhead + 8 <= n)
             for (size_t k = 0; k < 8; k += 2) __builtin_prefetch(planes + planeIndex[t + kPlaneAhead + k]);
         // Corners of the 8 triangles into lanes (a 4 x 4 transpose in each 128-bit half: triangle k
         // in lane k): per triangle k (and k + 4 in the upper half) the words x0 y0 x1 y1 and x1 y1 x2 y2.
@@ -413,8 +429,13 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
         const __m256i up = _mm256_set1_epi32(int32_t(kSubpixelOne - 1 - kHalf));
         const __m256i bx0 = _mm256_max_epi32(_mm256_srai_epi32(_mm256_add_epi32(minX, up), kSubpixelBits), zero);
         const __m256i bx1 = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(maxX, half), kSubpixelBits), lastX);
-        const __m256i by0 = _mm256_max_epi32(_mm256_srai_epi32(_mm256_add_epi32(minY, up), kSubpixelBits), zero);
-        const __m256i by1 = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(maxY, half), kSubpixelBits), lastY);
+        const __m256i vy0 = _mm256_max_epi32(_mm256_srai_epi32(_mm256_add_epi32(minY, up), kSubpixelBits), zero);
+        const __m256i vy1 = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(maxY, half), kSubpixelBits), lastY);
+        const __m256i by0 = _mm256_max_epi32(vy0, bandFirst), by1 = _mm256_min_epi32(vy1, bandLast);
+        const __m256i notHome = _mm256_cmpgt_epi32(bandFirst, vy0);
+        const unsigned notHomeBits = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(notHome)));
+        const unsigned sharedBits =
+            unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(notHome, _mm256_cmpgt_epi32(vy1, bandLast)))));
         const __m256i boxW1 = _mm256_sub_epi32(bx1, bx0), boxH1 = _mm256_sub_epi32(by1, by0);  // width - 1, height - 1
         const __m256i emptyBox = _mm256_or_si256(_mm256_cmpgt_epi32(zero, boxW1), _mm256_cmpgt_epi32(zero, boxH1));
         const __m256i notSmall =
@@ -477,6 +498,7 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
 
         // In submission order: small triangles from their masks, the others through the scalar walk.
         unsigned todo = ~skipBits & 0xFFu;
+        drawing = todo != 0;
         while (todo) {
             const int lane = std::countr_zero(todo);
             todo &= todo - 1;
@@ -487,6 +509,7 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, Si
             }
             const DepthPlane &plane = planes[planeIndex[tl]];
             if (!plane.valid) continue;
+            sink.band(!((notHomeBits >> lane) & 1), (sharedBits >> lane) & 1);
             if (!sink.beginTriangle(tl, (frontBits >> lane) & 1)) continue;
             const double pa = plane.a, pb = plane.b, pc = plane.c;
             const size_t x0l = size_t(boxX[lane]), y0l = size_t(boxY[lane]);

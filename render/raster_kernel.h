@@ -76,8 +76,20 @@ struct TileCounts {
 };
 
 using ShadeFn = void (*)(const ShadeTarget &, const TileWork &, TileCounts &);
-// The in-order walk into a cleared z-buffer (rasterizeWalk below), adding to the stats.
-using WalkFn = void (*)(const ScreenTriangles &, const ZBufferSettings &, ZBuffer &, ZBufferStats &);
+// One call of the in-order walk (rasterizeWalk below): the rows [rowBegin, rowEnd) of the z-buffer
+// (the whole viewport for the plain walk; any band for the batched one, bands may run concurrently).
+struct WalkBand {
+    int rowBegin = 0, rowEnd = 0;
+    // Per triangle, set to 1 when a triangle whose box reaches beyond the band drew a fragment in
+    // it (whether it drew at all is known over all bands); null when the band is the whole viewport.
+    uint8_t *sharedDrawn = nullptr;
+    bool concurrent = false;  // other bands run at the same time: per-source counts take atomic adds
+};
+// What a walk call counts (drawn: triangles that drew, those of sharedDrawn aside).
+struct WalkCounts {
+    uint64_t fragments = 0, passes = 0, outOfRange = 0, drawn = 0, backWinding = 0;
+};
+using WalkFn = void (*)(const ScreenTriangles &, const ZBufferSettings &, ZBuffer &, const WalkBand &, WalkCounts &);
 // The kernel for a depth format, projection and exactDepth, per instruction set.
 ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth);
 ShadeFn shadeFunctionAvx2(DepthFormat format, bool perspective, bool exactDepth);
@@ -176,23 +188,39 @@ struct ZBufferBatchSink {
     const uint8_t *singleSided;
     uint32_t *fragmentsPerSource;
     FragmentBatch<F, kPerspective, kExact> &batch;
-    uint32_t idValue = 0;
+    const WalkBand &walkBand;
+    uint64_t idValue = 0;  // 1 + source (uint64_t: see ZBufferSink)
+    bool home = true, shared = false;  // the current triangle's band flags (walkFragmentsBatched)
     uint64_t fragments = 0, drawn = 0, backWinding = 0;
 
+    void band(bool homeBand, bool sharedBox) {
+        home = homeBand;
+        shared = sharedBox;
+    }
     bool beginTriangle(size_t t, bool frontWinding) {
         const uint32_t src = source[t];
         if (singleSided && singleSided[src] && !frontWinding) {
-            ++backWinding;
+            backWinding += home ? 1 : 0;
             return false;
         }
         idValue = src + 1;
         return true;
     }
-    [[gnu::always_inline]] void fragment(size_t idx, size_t, double planeValue) { batch.push(idx, planeValue, idValue); }
+    [[gnu::always_inline]] void fragment(size_t idx, size_t, double planeValue) {
+        batch.push(idx, planeValue, uint32_t(idValue));
+    }
     void endTriangle(size_t t, uint64_t n) {
         fragments += n;
-        drawn += n != 0 ? 1 : 0;
-        if (fragmentsPerSource) fragmentsPerSource[source[t]] += uint32_t(n);
+        if (shared) {
+            if (n) std::atomic_ref<uint8_t>(walkBand.sharedDrawn[t]).store(1, std::memory_order_relaxed);
+        } else {
+            drawn += n != 0 ? 1 : 0;
+        }
+        if (fragmentsPerSource && n) {
+            uint32_t &slot = fragmentsPerSource[source[t]];
+            if (walkBand.concurrent) std::atomic_ref<uint32_t>(slot).fetch_add(uint32_t(n), std::memory_order_relaxed);
+            else slot += uint32_t(n);
+        }
     }
 };
 
@@ -258,45 +286,39 @@ struct ZBufferSink {
 // The in-order walk into the z-buffer: walkFragments, or with kBatched (AVX2 builds only)
 // walkFragmentsBatched, which gives the same fragments in the same triangle order.
 template <DepthFormat F, bool kExact, bool kBatched>
-void rasterizeWalk(const ScreenTriangles &tris, const ZBufferSettings &settings, ZBuffer &zb, ZBufferStats &st) {
-    ZBufferSink<F, kExact> sink{settings.encoder,    tris.source.data(), settings.singleSided,
-                                settings.fragmentsPerSource, zb.key.data(), zb.id.data(),
-                                zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
+void rasterizeWalk(const ScreenTriangles &tris, const ZBufferSettings &settings, ZBuffer &zb, const WalkBand &band,
+                   WalkCounts &counts) {
     if constexpr (kBatched) {
 #if defined(__AVX2__)
         auto run = [&]<bool kPerspective>() {
             auto batch = std::make_unique<FragmentBatch<F, kPerspective, kExact>>(
                 settings.encoder, zb.key.data(), zb.id.data(), zb.depth.data(), zb.fragments.data(), zb.passes.data());
-            ZBufferBatchSink<F, kPerspective, kExact> bs{tris.source.data(), settings.singleSided,
-                                                         settings.fragmentsPerSource, *batch};
-            walkFragmentsBatched<kPerspective>(tris, zb.width, zb.height, bs);
+            ZBufferBatchSink<F, kPerspective, kExact> sink{tris.source.data(), settings.singleSided,
+                                                           settings.fragmentsPerSource, *batch, band};
+            walkFragmentsBatched<kPerspective>(tris, zb.width, zb.height, band.rowBegin, band.rowEnd, sink);
             batch->flush();
-            sink.fragments = bs.fragments;
-            sink.drawn = bs.drawn;
-            sink.backWinding = bs.backWinding;
-            sink.passes = batch->passes;
-            sink.outOfRange = batch->outOfRange;
+            counts.fragments += sink.fragments;
+            counts.drawn += sink.drawn;
+            counts.backWinding += sink.backWinding;
+            counts.passes += batch->passes;
+            counts.outOfRange += batch->outOfRange;
         };
         if (settings.orthographic) run.template operator()<false>();
         else run.template operator()<true>();
 #endif
     } else {
+        ZBufferSink<F, kExact> sink{settings.encoder,    tris.source.data(), settings.singleSided,
+                                    settings.fragmentsPerSource, zb.key.data(), zb.id.data(),
+                                    zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
         if (settings.orthographic) walkFragments<false>(tris, zb.width, zb.height, sink);
         else walkFragments<true>(tris, zb.width, zb.height, sink);
-    }
-    st.fragments += sink.fragments;
-    st.depthPasses += sink.passes;
-    st.outOfRangeFragments += sink.outOfRange;
-    st.trianglesDrawn += sink.drawn;
-    st.trianglesEmpty += st.trianglesIn - sink.drawn;
-    st.trianglesBackWinding += sink.backWinding;
-    if constexpr (kExact) {
-        // The keys of the stored depths, so the buffer reads the same as a format-tested one.
-        for (size_t i = 0; i < zb.id.size(); ++i)
-            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
+        counts.fragments += sink.fragments;
+        counts.drawn += sink.drawn;
+        counts.backWinding += sink.backWinding;
+        counts.passes += sink.passes;
+        counts.outOfRange += sink.outOfRange;
     }
 }
-
 
 template <bool kBatched>
 inline WalkFn selectWalk(DepthFormat format, bool exactDepth) {

@@ -141,6 +141,12 @@ TEST(RasterTiles, RandomSoupsAllFormatsMatchPlainWalk) {
             for (bool avx2 : {true, false})
                 expectIdentical(rasterizeOn(1, tris, W, H, s, {Path::batchedWalk, avx2, 0}), want,
                                 name + (avx2 ? " batched walk avx2" : " batched walk base"));
+            // Bands of rows: one row each, uneven heights, on 1, 2 and 8 threads.
+            for (int bands : {2, 7, H})
+                for (int threads : {1, 2, 8})
+                    expectIdentical(rasterizeOn(threads, tris, W, H, s, {Path::batchedWalk, true, 0, bands}), want,
+                                    name + " batched walk, " + std::to_string(bands) + " bands, " +
+                                        std::to_string(threads) + " threads");
             for (int threads : {1, 2, 8})
                 expectIdentical(rasterizeOn(threads, tris, W, H, s, {}), want,
                                 name + " default " + std::to_string(threads) + " threads");
@@ -176,6 +182,16 @@ TEST(RasterTiles, OptionsMatchPlainWalk) {
                 expectIdentical(rasterizeOn(1, tris, W, H, s, {Path::batchedWalk, true, 0}), want, what);
                 EXPECT_TRUE(perSource == wantPerSource) << what;
             }
+            for (int bands : {3, 16})
+                for (int threads : {1, 2, 8}) {
+                    std::vector<uint32_t> perSource(sources, 0);
+                    s.fragmentsPerSource = perSource.data();
+                    const std::string what = std::string(exact ? "exact" : "keyed") + (oneSided ? " single-sided" : "") +
+                                             " batched walk, " + std::to_string(bands) + " bands, " +
+                                             std::to_string(threads) + " threads";
+                    expectIdentical(rasterizeOn(threads, tris, W, H, s, {Path::batchedWalk, true, 0, bands}), want, what);
+                    EXPECT_TRUE(perSource == wantPerSource) << what;
+                }
             for (int shift : {4, 7})
                 for (int threads : {1, 2, 8}) {
                     std::vector<uint32_t> perSource(sources, 0);
@@ -205,6 +221,8 @@ TEST(RasterTiles, BenchSceneMatchesPlainWalk) {
     EXPECT_EQ(want.stats.trianglesIn, 1000002u);
     expectIdentical(rasterizeOn(2, clip.out, cam.width, cam.height, s, {}), want, "bench scene, default, 2 threads");
     expectIdentical(rasterizeOn(1, clip.out, cam.width, cam.height, s, {}), want, "bench scene, default, 1 thread");
+    expectIdentical(rasterizeOn(2, clip.out, cam.width, cam.height, s, {Path::tiled, true, 0}), want,
+                    "bench scene, tiled, 2 threads");
 }
 
 }  // namespace
