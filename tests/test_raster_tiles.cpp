@@ -1,5 +1,6 @@
-// The tiled rasterizer (render/raster_kernel.h, docs/rasterizer.md: Tiles) against the plain walk:
-// byte-identical buffers and identical stats for every tiling, instruction set and thread count.
+// The tiled rasterizer (render/raster_kernel.h, docs/rasterizer.md: Tiles) and the batched walk
+// (raster_core.h's walkFragmentsBatched, in bands of rows) against the plain walk: byte-identical
+// buffers and identical stats for every tiling, band count, instruction set and thread count.
 //
 // The plain walk itself is checked against an independent brute force in test_raster.cpp; here it
 // is the reference (RasterStrategy::Path::plainWalk). Soups mix every size class the kernel treats
