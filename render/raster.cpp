@@ -1,12 +1,12 @@
 // The z-buffer rasterizer (raster.h; decisions in docs/rasterizer.md).
 //
-// Structure: rasterize() clears the buffers, then dispatches once on (depth format, projection,
-// exactDepth) to the coverage walk of raster_core.h (forEachFragment) with the z-buffer as its
-// sink, so the per-fragment depth encoding is inlined and branch-free. The walk does orientation,
-// the box of pixel centers, int64 edge functions and the three coverage paths; the sink does, per
-// covered center, encode and LESS written as selects (no branch on the depth test's outcome), and
-// the per-triangle counts. The audits' options (single-sided winding, per-source fragment counts)
-// are tested once per triangle, never per fragment.
+// Structure: rasterize() clears the buffers, then picks a path (RasterStrategy) and dispatches once
+// on (depth format, projection, exactDepth) to a function of raster_kernel.h, so the per-fragment
+// depth encoding is inlined and branch-free: the batched walk (AVX2, raster_avx2.cpp; in bands of
+// rows on several threads), the plain walk of raster_core.h with the z-buffer as its sink (the
+// reference), or the tiled path below (binning here, the tile kernel in raster_kernel.h). Each
+// resolves a pixel's fragments in submission order with LESS written as selects; the audits'
+// options (single-sided winding, per-source fragment counts) are tested once per triangle.
 #include "render/raster.h"
 
 #include <algorithm>
@@ -168,9 +168,6 @@ void rasterizeTiled(const ScreenTriangles &tris, const ZBufferSettings &settings
     }
     st.trianglesDrawn += drawn;
     st.trianglesEmpty += st.trianglesIn - drawn;
-    if (settings.exactDepth)
-        for (size_t i = 0; i < zb.id.size(); ++i)
-            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
 }
 
 }  // namespace
@@ -215,7 +212,8 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
         rasterizeTiled(tris, settings, strategy, threads, zb, st);
     } else if (pixels > 0) {
         WalkFn walk = strategy.path != Path::plainWalk ? batched : nullptr;
-        // Bands of rows in parallel (batched walk only): a few per thread, so uneven bands even out.
+        // Bands of rows in parallel (batched walk only): one per thread by default, since each extra
+        // band scans every triangle again (docs/rasterizer.md: The batched walk).
         int bands = 1;
         if (walk && (strategy.path == Path::automatic || strategy.path == Path::batchedWalk))
             bands = strategy.bands > 0 ? strategy.bands : threads > 1 ? kBandsPerThread * threads : 1;
@@ -243,13 +241,13 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
         for (uint8_t d : sharedDrawn) drawn += d;
         st.trianglesDrawn += drawn;
         st.trianglesEmpty += st.trianglesIn - drawn;
-        if (settings.exactDepth) {
-            // The keys of the stored depths, so the buffer reads the same as a format-tested one.
-            for (size_t i = 0; i < zb.id.size(); ++i)
-                if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
-        }
     } else {
         st.trianglesEmpty = tris.size();
+    }
+    if (settings.exactDepth) {
+        // The keys of the stored depths, so the buffer reads the same as a format-tested one.
+        for (size_t i = 0; i < zb.id.size(); ++i)
+            if (zb.id[i] != 0) zb.key[i] = depthKey(settings.encoder, zb.depth[i]);
     }
     finishZBufferStats(zb, &st);
     return r;
