@@ -140,10 +140,9 @@ void rasterizeTiled(const ScreenTriangles &tris, const ZBufferSettings &settings
         shade = shadeFunctionAvx2(settings.encoder.format, perspective, settings.exactDepth);
 #endif
     if (!shade) shade = shadeFunctionBase(settings.encoder.format, perspective, settings.exactDepth);
-    const ShadeTarget target{tris.xy.data(),  tris.source.data(), tris.plane.data(), tris.planes.data(),
-                             &settings.encoder, settings.fragmentsPerSource, threads > 1, size_t(g.width),
-                             zb.key.data(),   zb.id.data(),       zb.depth.data(),   zb.fragments.data(),
-                             zb.passes.data()};
+    const ShadeTarget target{tris.xy.data(),      tris.source.data(),          tris.plane.data(),
+                             tris.planes.data(),  &settings.encoder,           settings.fragmentsPerSource,
+                             threads > 1,         size_t(g.width),             PixelBuffers(zb)};
     std::vector<TileCounts> counts(g.count());
     auto shadeOne = [&](size_t tile) {
         const int64_t tx = int64_t(tile) % g.cols, ty = int64_t(tile) / g.cols;
@@ -211,14 +210,13 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
     if (pixels > 0 && tiled) {
         rasterizeTiled(tris, settings, strategy, threads, zb, st);
     } else if (pixels > 0) {
+        // The batched walk in bands of rows (in parallel): one per thread by default, since each
+        // extra band scans every triangle again (docs/rasterizer.md: The batched walk). Otherwise
+        // the plain walk over the whole viewport.
         WalkFn walk = strategy.path != Path::plainWalk ? batched : nullptr;
-        // Bands of rows in parallel (batched walk only): one per thread by default, since each extra
-        // band scans every triangle again (docs/rasterizer.md: The batched walk).
         int bands = 1;
-        if (walk && (strategy.path == Path::automatic || strategy.path == Path::batchedWalk))
-            bands = strategy.bands > 0 ? strategy.bands : threads > 1 ? kBandsPerThread * threads : 1;
-        bands = std::clamp(bands, 1, zb.height);
-        if (!walk) walk = walkFunctionBase(settings.encoder.format, settings.exactDepth);
+        if (walk) bands = std::clamp(strategy.bands > 0 ? strategy.bands : kBandsPerThread * threads, 1, zb.height);
+        else walk = walkFunctionBase(settings.encoder.format, settings.exactDepth);
         std::vector<WalkCounts> counts(static_cast<size_t>(bands));
         std::vector<uint8_t> sharedDrawn(bands > 1 ? tris.size() : 0, uint8_t(0));
         auto runBand = [&](size_t b) {

@@ -278,19 +278,6 @@ struct TriangleSetup {
     return true;
 }
 
-// The walk for one projection (see the contract above; the steps per triangle):
-//   1. the bounding box of the *pixel centers* it may cover, clamped to the viewport; empty box ->
-//      done (the common case for the benchmark scene's sub-pixel triangles: no edge setup at all);
-//   2. orientation: twice the signed area in fixed point; zero -> skipped, negative (the front
-//      winding) -> swap v1, v2 so every triangle is walked with the same inside test;
-//   3. edge functions in int64 at the first center, stepped exactly by integer increments;
-//   4. coverage (coverTriangle), by the size of the box (all give the same set of centers, exactly):
-//      - small (box <= 8 x 8 centers, vertex extent <= 64 px): one 4 x 4 or 8 x 8 block of inside
-//        tests in 32-bit SIMD lanes into a bit mask, without data-dependent branches;
-//      - wide (box >= kSpanMinWidth): each row's covered span solved with integer floor division,
-//        so large triangles cost per row, not per empty center of their box;
-//      - otherwise: every center of the box, stepping the edge functions;
-//   5. per covered center: view depth straight from the DepthPlane, then sink.fragment.
 // The fragment call of the contract above: v is the plane value at the center.
 template <bool kPerspective, class Sink>
 [[gnu::always_inline]] inline void emitFragment(Sink &sink, size_t idx, size_t t, double v) {
@@ -298,25 +285,33 @@ template <bool kPerspective, class Sink>
     else sink.fragment(idx, t, kPerspective ? 1.0 / v : v);
 }
 
-// Steps 2-5 of the walk below for triangle t, whose step 1 (setupTriangle) gave ts.
+// Steps 2-5 of the walk below for triangle t once its coverage is known: the depth plane (invalid:
+// nothing), beginTriangle, then for every covered center -- `cover(frag)` calls frag(pixel, x, y)
+// once per center -- the depth straight from the plane exactly as evalDepthPlane writes it
+// ((a*px + b*py) + c) to the sink, then endTriangle with the count.
+template <bool kPerspective, class Sink, class Cover>
+[[gnu::always_inline]] inline void shadeTriangle(const ScreenTriangles &tris, size_t t, bool frontWinding, Sink &sink,
+                                                 Cover &&cover) {
+    const DepthPlane &plane = tris.planes[tris.plane[t]];
+    if (!plane.valid) return;
+    if (!sink.beginTriangle(t, frontWinding)) return;
+    uint64_t triFragments = 0;
+    const double pa = plane.a, pb = plane.b, pc = plane.c;
+    cover([&](size_t idx, int64_t x, int64_t y) {
+        const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
+        ++triFragments;
+        emitFragment<kPerspective>(sink, idx, t, pv);
+    });
+    sink.endTriangle(t, triFragments);
+}
+
+// Steps 2-5 for triangle t, whose step 1 (setupTriangle) gave ts: coverage by coverTriangle.
 template <bool kPerspective, class Sink>
 [[gnu::always_inline]] inline void walkSetUpTriangle(const ScreenTriangles &tris, size_t t, const TriangleSetup &ts,
                                                      size_t W, Sink &sink) {
-    const DepthPlane plane = tris.planes[tris.plane[t]];
-    if (!plane.valid) return;
-    if (!sink.beginTriangle(t, ts.frontWinding)) return;
-
-    // One covered center: depth from the plane exactly as evalDepthPlane writes it
-    // ((a*px + b*py) + c), then the sink.
-    uint64_t triFragments = 0;
-    const double pa = plane.a, pb = plane.b, pc = plane.c;
-    coverTriangle(ts.x0, ts.y0, ts.x1, ts.y1, ts.x2, ts.y2, ts.ext, ts.bx0, ts.bx1, ts.by0, ts.by1, W,
-                  [&](size_t idx, int64_t x, int64_t y) {
-                      const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
-                      ++triFragments;
-                      emitFragment<kPerspective>(sink, idx, t, pv);
-                  });
-    sink.endTriangle(t, triFragments);
+    shadeTriangle<kPerspective>(tris, t, ts.frontWinding, sink, [&](auto &&frag) {
+        coverTriangle(ts.x0, ts.y0, ts.x1, ts.y1, ts.x2, ts.y2, ts.ext, ts.bx0, ts.bx1, ts.by0, ts.by1, W, frag);
+    });
 }
 
 // The walk for one projection (see the contract above; the steps per triangle):
@@ -507,23 +502,15 @@ void walkFragmentsBatched(const ScreenTriangles &tris, int width, int height, in
                 scalar(tl);
                 continue;
             }
-            const DepthPlane &plane = planes[planeIndex[tl]];
-            if (!plane.valid) continue;
             sink.band(!((notHomeBits >> lane) & 1), (sharedBits >> lane) & 1);
-            if (!sink.beginTriangle(tl, (frontBits >> lane) & 1)) continue;
-            const double pa = plane.a, pb = plane.b, pc = plane.c;
-            const size_t x0l = size_t(boxX[lane]), y0l = size_t(boxY[lane]);
-            uint32_t mask = uint32_t(cover[lane]);
-            uint64_t triFragments = 0;
-            while (mask) {
-                const int bit = std::countr_zero(mask);
-                mask &= mask - 1;
-                const size_t x = x0l + size_t(bit & 3), y = y0l + size_t(bit >> 2);
-                const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
-                ++triFragments;
-                emitFragment<kPerspective>(sink, y * size_t(W) + x, tl, pv);
-            }
-            sink.endTriangle(tl, triFragments);
+            const int64_t bx = boxX[lane], by = boxY[lane];
+            shadeTriangle<kPerspective>(tris, tl, (frontBits >> lane) & 1, sink, [&](auto &&frag) {
+                for (uint32_t mask = uint32_t(cover[lane]); mask; mask &= mask - 1) {
+                    const int bit = std::countr_zero(mask);
+                    const int64_t x = bx + (bit & 3), y = by + (bit >> 2);
+                    frag(size_t(y) * size_t(W) + size_t(x), x, y);
+                }
+            });
         }
     }
     for (; t < n; ++t) scalar(t);

@@ -46,6 +46,40 @@ struct BinList {
     uint32_t *multiCounts = nullptr;  // the chunk's per-multi-tile-triangle fragment counts (atomic adds)
 };
 
+// The z-buffer's five per-pixel buffers (ZBuffer's vectors' data) and the one place a fragment is
+// resolved into them: resolve() counts the fragment at the pixel, runs LESS on the keys (kExact: on
+// the double depths; on equal values the first drawn fragment stays) and on a pass writes key, id
+// and depth and counts the pass. Written as selects, not branches: about half the fragments pass,
+// in no predictable pattern. Counters saturate at 0xFFFF.
+struct PixelBuffers {
+    uint32_t *key;
+    uint32_t *id;
+    double *depth;
+    uint16_t *fragments;
+    uint16_t *passes;
+
+    explicit PixelBuffers(ZBuffer &zb)
+        : key(zb.key.data()), id(zb.id.data()), depth(zb.depth.data()), fragments(zb.fragments.data()),
+          passes(zb.passes.data()) {}
+
+    template <bool kExact>
+    [[gnu::always_inline]] bool resolve(size_t idx, uint32_t newKey, double d, uint32_t newId) const {
+        fragments[idx] += fragments[idx] != 0xFFFF ? 1 : 0;
+        bool pass;
+        if constexpr (kExact) {
+            pass = d < depth[idx];
+        } else {
+            const uint32_t oldKey = key[idx];
+            pass = newKey < oldKey;
+            key[idx] = pass ? newKey : oldKey;
+        }
+        id[idx] = pass ? newId : id[idx];
+        depth[idx] = pass ? d : depth[idx];
+        passes[idx] += (pass && passes[idx] != 0xFFFF) ? 1 : 0;
+        return pass;
+    }
+};
+
 // Everything a kernel call reads and writes besides its tile's bins.
 struct ShadeTarget {
     const int32_t *xy;
@@ -56,11 +90,7 @@ struct ShadeTarget {
     uint32_t *fragmentsPerSource;  // may be null
     bool concurrent;               // tiles run concurrently: shared counters take atomic adds
     size_t width;
-    uint32_t *key;
-    uint32_t *id;
-    double *depth;
-    uint16_t *fragments;
-    uint16_t *passes;
+    PixelBuffers buffers;
 };
 
 // A tile: inclusive pixel rectangle, its bin lists in submission order (chunk order).
@@ -115,21 +145,17 @@ struct FragmentBatch {
     size_t n = 0;
     uint64_t passes = 0, outOfRange = 0;
     DepthEncoder enc;  // a copy: loads through a pointer keep GCC from vectorizing the encode loop
-    uint32_t *keyBuf, *idBuf;
-    double *depthBuf;
-    uint16_t *fragBuf, *passBuf;
+    PixelBuffers buf;
 
-    FragmentBatch(const DepthEncoder &encoder, uint32_t *key, uint32_t *id, double *depth, uint16_t *fragments,
-                  uint16_t *passes_)
-        : enc(encoder), keyBuf(key), idBuf(id), depthBuf(depth), fragBuf(fragments), passBuf(passes_) {}
+    FragmentBatch(const DepthEncoder &encoder, const PixelBuffers &buffers) : enc(encoder), buf(buffers) {}
 
     [[gnu::always_inline]] void push(size_t idx, double planeValue, uint32_t id) {
         // The flush reads and writes these kBatch fragments later: fetch their lines now.
-        __builtin_prefetch(keyBuf + idx, 1);
-        __builtin_prefetch(idBuf + idx, 1);
-        __builtin_prefetch(depthBuf + idx, 1);
-        __builtin_prefetch(fragBuf + idx, 1);
-        __builtin_prefetch(passBuf + idx, 1);
+        __builtin_prefetch(buf.key + idx, 1);
+        __builtin_prefetch(buf.id + idx, 1);
+        __builtin_prefetch(buf.depth + idx, 1);
+        __builtin_prefetch(buf.fragments + idx, 1);
+        __builtin_prefetch(buf.passes + idx, 1);
         value[n] = planeValue;
         pixel[n] = uint32_t(idx);
         ids[n] = id;
@@ -151,29 +177,9 @@ struct FragmentBatch {
             }
             outOfRange += oor;
         }
-        uint32_t *const kb = keyBuf, *const ib = idBuf;
-        uint16_t *const pb = passBuf, *const fb = fragBuf;
-        double *const db = depthBuf;
+        const PixelBuffers b = buf;
         uint64_t p = 0;
-        for (size_t i = 0; i < n; ++i) {
-            const size_t idx = pixel[i];
-            const double d = value[i];
-            fb[idx] += fb[idx] != 0xFFFF ? 1 : 0;
-            // LESS: on equal keys (or equal depths) the first drawn fragment stays; selects, not a
-            // branch (about half the fragments pass, in no predictable pattern).
-            bool pass;
-            if constexpr (kExact) {
-                pass = d < db[idx];
-            } else {
-                const uint32_t oldKey = kb[idx];
-                pass = keys[i] < oldKey;
-                kb[idx] = pass ? keys[i] : oldKey;
-            }
-            ib[idx] = pass ? ids[i] : ib[idx];
-            db[idx] = pass ? d : db[idx];
-            pb[idx] += (pass && pb[idx] != 0xFFFF) ? 1 : 0;
-            p += pass ? 1 : 0;
-        }
+        for (size_t i = 0; i < n; ++i) p += b.resolve<kExact>(pixel[i], kExact ? 0 : keys[i], value[i], ids[i]) ? 1 : 0;
         passes += p;
         n = 0;
     }
@@ -234,11 +240,7 @@ struct ZBufferSink {
     const uint32_t *source;           // ScreenTriangles::source
     const uint8_t *singleSided;       // settings.singleSided (may be null)
     uint32_t *fragmentsPerSource;     // settings.fragmentsPerSource (may be null)
-    uint32_t *keyBuf;
-    uint32_t *idBuf;
-    double *depthBuf;
-    uint16_t *fragBuf;
-    uint16_t *passBuf;
+    PixelBuffers buf;
     // 1 + source of the current triangle, held as uint64_t: a uint32_t member could alias the
     // uint32_t buffers written per fragment, forcing a reload after every store.
     uint64_t idValue = 0;
@@ -255,25 +257,13 @@ struct ZBufferSink {
     }
 
     [[gnu::always_inline]] void fragment(size_t idx, size_t, double d) {
-        fragBuf[idx] += fragBuf[idx] != 0xFFFF ? 1 : 0;
-        // LESS: on equal keys (or equal depths) the first drawn fragment stays. Written as selects,
-        // not a branch: about half the fragments pass, in no predictable pattern.
-        bool pass;
-        if constexpr (kExact) {
-            pass = d < depthBuf[idx];
-        } else {
-            uint32_t key;
+        uint32_t key = 0;
+        if constexpr (!kExact) {
             bool oor = false;
             encodeDepth<F>(enc, d, key, oor);
             outOfRange += oor ? 1 : 0;
-            const uint32_t oldKey = keyBuf[idx];
-            pass = key < oldKey;
-            keyBuf[idx] = pass ? key : oldKey;
         }
-        idBuf[idx] = pass ? uint32_t(idValue) : idBuf[idx];
-        depthBuf[idx] = pass ? d : depthBuf[idx];
-        passBuf[idx] += (pass && passBuf[idx] != 0xFFFF) ? 1 : 0;
-        passes += pass ? 1 : 0;
+        passes += buf.resolve<kExact>(idx, key, d, uint32_t(idValue)) ? 1 : 0;
     }
 
     void endTriangle(size_t t, uint64_t n) {
@@ -291,8 +281,7 @@ void rasterizeWalk(const ScreenTriangles &tris, const ZBufferSettings &settings,
     if constexpr (kBatched) {
 #if defined(__AVX2__)
         auto run = [&]<bool kPerspective>() {
-            auto batch = std::make_unique<FragmentBatch<F, kPerspective, kExact>>(
-                settings.encoder, zb.key.data(), zb.id.data(), zb.depth.data(), zb.fragments.data(), zb.passes.data());
+            auto batch = std::make_unique<FragmentBatch<F, kPerspective, kExact>>(settings.encoder, PixelBuffers(zb));
             ZBufferBatchSink<F, kPerspective, kExact> sink{tris.source.data(), settings.singleSided,
                                                            settings.fragmentsPerSource, *batch, band};
             walkFragmentsBatched<kPerspective>(tris, zb.width, zb.height, band.rowBegin, band.rowEnd, sink);
@@ -307,9 +296,8 @@ void rasterizeWalk(const ScreenTriangles &tris, const ZBufferSettings &settings,
         else run.template operator()<true>();
 #endif
     } else {
-        ZBufferSink<F, kExact> sink{settings.encoder,    tris.source.data(), settings.singleSided,
-                                    settings.fragmentsPerSource, zb.key.data(), zb.id.data(),
-                                    zb.depth.data(),     zb.fragments.data(), zb.passes.data()};
+        ZBufferSink<F, kExact> sink{settings.encoder, tris.source.data(), settings.singleSided,
+                                    settings.fragmentsPerSource, PixelBuffers(zb)};
         if (settings.orthographic) walkFragments<false>(tris, zb.width, zb.height, sink);
         else walkFragments<true>(tris, zb.width, zb.height, sink);
         counts.fragments += sink.fragments;
@@ -328,7 +316,7 @@ inline WalkFn selectWalk(DepthFormat format, bool exactDepth) {
 
 template <DepthFormat F, bool kPerspective, bool kExact>
 void shadeTile(const ShadeTarget &s, const TileWork &w, TileCounts &counts) {
-    FragmentBatch<F, kPerspective, kExact> batch(*s.encoder, s.key, s.id, s.depth, s.fragments, s.passes);
+    FragmentBatch<F, kPerspective, kExact> batch(*s.encoder, s.buffers);
     const size_t W = s.width;
     uint64_t fragments = 0, drawnSingle = 0;
     for (size_t l = 0; l < w.listCount; ++l) {

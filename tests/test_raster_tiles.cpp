@@ -175,34 +175,22 @@ TEST(RasterTiles, OptionsMatchPlainWalk) {
             if (oneSided) {
                 EXPECT_GT(want.stats.trianglesBackWinding, 1000u);
             }
-            {
+            // A strategy on a thread count: the same buffers, stats and per-source counts.
+            auto check = [&](const RasterStrategy &strategy, int threads, const std::string &label) {
                 std::vector<uint32_t> perSource(sources, 0);
                 s.fragmentsPerSource = perSource.data();
-                const std::string what = std::string(exact ? "exact" : "keyed") + (oneSided ? " single-sided" : "") +
-                                         " batched walk";
-                expectIdentical(rasterizeOn(1, tris, W, H, s, {Path::batchedWalk, true, 0}), want, what);
+                const std::string what = std::string(exact ? "exact" : "keyed") + (oneSided ? " single-sided " : " ") +
+                                         label + ", " + std::to_string(threads) + " threads";
+                expectIdentical(rasterizeOn(threads, tris, W, H, s, strategy), want, what);
                 EXPECT_TRUE(perSource == wantPerSource) << what;
+            };
+            check({Path::batchedWalk, true, 0}, 1, "batched walk");
+            for (int threads : {1, 2, 8}) {
+                for (int bands : {3, 16})
+                    check({Path::batchedWalk, true, 0, bands}, threads, "batched walk, " + std::to_string(bands) + " bands");
+                for (int shift : {4, 7})
+                    check({Path::tiled, true, shift}, threads, "tiles " + std::to_string(1 << shift));
             }
-            for (int bands : {3, 16})
-                for (int threads : {1, 2, 8}) {
-                    std::vector<uint32_t> perSource(sources, 0);
-                    s.fragmentsPerSource = perSource.data();
-                    const std::string what = std::string(exact ? "exact" : "keyed") + (oneSided ? " single-sided" : "") +
-                                             " batched walk, " + std::to_string(bands) + " bands, " +
-                                             std::to_string(threads) + " threads";
-                    expectIdentical(rasterizeOn(threads, tris, W, H, s, {Path::batchedWalk, true, 0, bands}), want, what);
-                    EXPECT_TRUE(perSource == wantPerSource) << what;
-                }
-            for (int shift : {4, 7})
-                for (int threads : {1, 2, 8}) {
-                    std::vector<uint32_t> perSource(sources, 0);
-                    s.fragmentsPerSource = perSource.data();
-                    const std::string what = std::string(exact ? "exact" : "keyed") + (oneSided ? " single-sided" : "") +
-                                             " tiles " + std::to_string(1 << shift) + " " + std::to_string(threads) +
-                                             " threads";
-                    expectIdentical(rasterizeOn(threads, tris, W, H, s, {Path::tiled, true, shift}), want, what);
-                    EXPECT_TRUE(perSource == wantPerSource) << what;
-                }
         }
 }
 
