@@ -133,6 +133,11 @@ int main(int argc, char **argv) {
         {"tiled, AVX2 if present", 1, {Path::tiled, true, 0}},
         {"default", allThreads, {}},
     };
+    if (only >= int(configs.size())) {
+        std::fprintf(stderr, "bench_zbuffer: --only %d: there are %zu configurations (0 to %zu)\n", only,
+                     configs.size(), configs.size() - 1);
+        return 2;
+    }
     if (tileShift > 0)
         for (Config &c : configs) c.strategy.tileShift = tileShift;
     std::printf("%-24s %7s %10s %10s %10s %12s %12s\n", "rasterize", "threads", "best ms", "median ms", "CPU ms",
