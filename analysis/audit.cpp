@@ -2,7 +2,6 @@
 #include "analysis/audit.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -11,13 +10,12 @@
 #include "analysis/backface.h"
 #include "render/raster.h"
 #include "render/raster_core.h"
+#include "render/stopwatch.h"
 
 namespace va {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // The reference as a fragment sink: single-sided triangles only with the front winding, LESS on
 // the double depth with ties to the lowest id (so the order of submission does not matter).
@@ -124,7 +122,7 @@ std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
 }
 
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     ReferenceVisibility r;
     r.width = std::max(cam.width, 0);
     r.height = std::max(cam.height, 0);
@@ -166,7 +164,7 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
             objectVisible[scene.triangleObject[t]] = 1;
         }
     for (uint8_t v : objectVisible) r.visibleObjects += v;
-    r.ms = msSince(t0);
+    r.ms = t0.ms();
     return r;
 }
 
@@ -174,7 +172,7 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
 
 CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const std::vector<StageCulls> &stages,
                        const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     CullAudit a;
     const size_t nt = scene.triangleCount();
 
@@ -280,7 +278,7 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
             ++a.unaccountedPixels;
         }
     }
-    a.ms = msSince(t0);
+    a.ms = t0.ms();
     return a;
 }
 
@@ -394,7 +392,7 @@ Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const D
 CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector<double> &zbufferDepth,
                       const std::vector<uint32_t> &raycastIds, const std::vector<float> &raycastDepth,
                       const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     CrossCheck c;
     c.width = cam.width;
     c.height = cam.height;
@@ -426,7 +424,7 @@ CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector
         case Disagreement::none: break;
         }
     }
-    c.ms = msSince(t0);
+    c.ms = t0.ms();
     return c;
 }
 

@@ -5,15 +5,15 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
+
+#include "render/stopwatch.h"
 
 namespace va {
 
 namespace {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Clock = std::chrono::steady_clock;
 constexpr uint32_t kInputVertex = std::numeric_limits<uint32_t>::max();
 
 K::Point_3 P(Vec3 v) { return K::Point_3(v.x, v.y, v.z); }
@@ -254,7 +254,7 @@ int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
 }
 
 BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles, const BspSettings &settings) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     BspTree tree;
     Builder b{scene, settings, tree, {}, 0};
     std::vector<uint32_t> list;
@@ -292,7 +292,7 @@ BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles,
     st.memoryBytes = tree.nodes.size() * sizeof(BspTreeNode) + tree.pieces.size() * sizeof(BspPiece) +
                      tree.nodePieces.size() * sizeof(uint32_t) + tree.vertices.size() * sizeof(Vec3) +
                      tree.constraints.size() * sizeof(BspConstraint);
-    st.buildMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    st.buildMs = t0.ms();
     return tree;
 }
 

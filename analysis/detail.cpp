@@ -2,9 +2,10 @@
 #include "analysis/detail.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
+
+#include "render/stopwatch.h"
 
 namespace va {
 
@@ -18,7 +19,7 @@ double projectedDiameterPx(const Camera &cam, const Sphere &s) {
 DetailResult auditDetail(const Scene &scene, const Camera &cam, const std::vector<uint32_t> &drawnTriangles,
                          const std::vector<uint32_t> &fragmentsPerSource, const std::vector<uint32_t> &visibleIds,
                          const DetailSettings &settings) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch t0;
     DetailResult r;
     const size_t n = scene.objects.size();
     std::vector<DetailObject> per(n);
@@ -70,7 +71,7 @@ DetailResult auditDetail(const Scene &scene, const Camera &cam, const std::vecto
         return a.trianglesSaved > b.trianglesSaved || (a.trianglesSaved == b.trianglesSaved && a.object < b.object);
     });
     if (r.flagged.size() > settings.listed) r.flagged.resize(settings.listed);
-    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.ms = t0.ms();
     return r;
 }
 

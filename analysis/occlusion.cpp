@@ -3,20 +3,18 @@
 #include "analysis/occlusion.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include "render/clip.h"
 #include "render/raster.h"
 #include "render/raster_core.h"
+#include "render/stopwatch.h"
 
 namespace va {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -110,7 +108,7 @@ OcclusionResult cullOcclusion(const Scene &scene, const Camera &cam, const std::
                               const OcclusionSettings &settings) {
     OcclusionResult r;
     OcclusionStats &st = r.stats;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
 
     // 1. Occluders and their depth pre-pass, through the pipeline's clipper and fragment core.
@@ -134,10 +132,10 @@ OcclusionResult cullOcclusion(const Scene &scene, const Camera &cam, const std::
     for (double d : depth) st.prepassPixels += d < kInf;
     const HiZ hiz = buildHiZ(std::move(depth), W, H);
     st.hizLevels = hiz.levels();
-    st.prepassMs = msSince(t0);
+    st.prepassMs = t0.ms();
 
     // 2. Every other object's box against the pyramid.
-    const auto t1 = Clock::now();
+    const Stopwatch t1;
     const double margin = 1.0 / 256;  // px: twice the rasterizer's vertex snapping (1/512 px per axis)
     for (uint32_t o : objects) {
         const SceneObject &ob = scene.objects[o];
@@ -200,7 +198,7 @@ OcclusionResult cullOcclusion(const Scene &scene, const Camera &cam, const std::
             r.visible.push_back(o);
         }
     }
-    st.testMs = msSince(t1);
+    st.testMs = t1.ms();
     return r;
 }
 

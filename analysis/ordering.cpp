@@ -2,19 +2,17 @@
 #include "analysis/ordering.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
 
 #include "render/clip.h"
 #include "render/raster_core.h"
+#include "render/stopwatch.h"
 
 namespace va {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 Vec3 vertexOf(const Scene &s, uint32_t t, int i) { return s.positions[s.indices[3 * size_t(t) + i]]; }
 
@@ -73,7 +71,7 @@ struct OrderSink {
 }  // namespace
 
 OrderingView prepareOrderingView(const Scene &scene, const Camera &cam) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     OrderingView v;
     v.scene = &scene;
     v.cam = cam;
@@ -91,7 +89,7 @@ OrderingView prepareOrderingView(const Scene &scene, const Camera &cam) {
         v.screenEnd[s] = uint32_t(t + 1);
     }
     v.singleSided = singleSidedTriangles(scene);
-    v.clipMs = msSince(t0);
+    v.clipMs = t0.ms();
     return v;
 }
 
@@ -156,7 +154,7 @@ std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
 
 DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest, const BspTree *tree,
                       const BspViewPlanes *planes, std::vector<uint32_t> *idsOut) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     DrawStats st;
     // The draw list: each item's screen triangles, in item order (depth planes shared with `all`).
     ScreenTriangles list;
@@ -181,7 +179,7 @@ DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items,
     for (uint32_t i : id) st.coveredPixels += i != 0;
     st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
     st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
-    st.ms = msSince(t0);
+    st.ms = t0.ms();
     if (idsOut) *idsOut = std::move(id);
     return st;
 }
@@ -243,7 +241,7 @@ int eyeSide(const Scene &s, const Camera &cam, uint32_t q) {
 }  // namespace
 
 OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     OverlapTests r;
     const Scene &scene = *v.scene;
     const std::vector<uint32_t> order = painterOrder(v, key);
@@ -333,7 +331,7 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
             }
         }
     r.boundsDisjoint = r.pairs - boundsOverlap;
-    r.ms = msSince(t0);
+    r.ms = t0.ms();
     return r;
 }
 
@@ -341,9 +339,9 @@ PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility
                                 bool overlapTests) {
     PainterResult r;
     r.key = key;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const std::vector<uint32_t> order = painterOrder(v, key);
-    r.sortMs = msSince(t0);
+    r.sortMs = t0.ms();
     std::vector<DrawItem> items(order.size());
     for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
     r.trianglesDrawn = order.size();
@@ -364,10 +362,10 @@ PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility
 
 BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree) {
     BspViewResult r;
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     const std::vector<uint32_t> order = bspBackToFront(tree, *v.scene, v.cam);
     const BspViewPlanes planes = bspViewPlanes(tree, *v.scene, v.cam);
-    r.traverseMs = msSince(t0);
+    r.traverseMs = t0.ms();
     std::vector<DrawItem> items;
     items.reserve(order.size());
     for (uint32_t p : order)
@@ -414,7 +412,7 @@ ABufferResult abufferForView(const OrderingView &v, uint32_t maxListLength) {
 
 OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const ReferenceVisibility &ref,
                                const BspTree &tree, const EffectDecision &abuffer, const OrderingSettings &settings) {
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     OrderingResult r;
     const OrderingView v = prepareOrderingView(scene, cam);
     const size_t pixels = size_t(std::max(cam.width, 0)) * size_t(std::max(cam.height, 0));
@@ -469,9 +467,9 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         zs.orthographic = cam.orthographic;
         zs.exactDepth = true;
         zs.singleSided = v.singleSided.data();
-        const auto tz = Clock::now();
+        const Stopwatch tz;
         const ZBufferResult z = rasterize(v.all, cam.width, cam.height, zs);
-        zrow.drawMs = msSince(tz);
+        zrow.drawMs = tz.ms();
         const PixelComparison c = compareWithReference(v, ref, z.buffer.id);
         zrow.wrongPixels = c.wrongPixels;
         zrow.tiePixels = c.tiePixels;
@@ -500,7 +498,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         r.abuffer = abufferForView(v, settings.abufferMaxList);
         r.abufferRan = true;
     }
-    r.ms = msSince(t0);
+    r.ms = t0.ms();
     return r;
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <mutex>
 
 #include <tbb/global_control.h>
@@ -13,15 +12,11 @@
 #include "analysis/cells.h"
 #include "analysis/level_views.h"
 #include "render/raster.h"
+#include "render/stopwatch.h"
 
 namespace va {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 uint64_t trianglesOf(const Scene &scene, const std::vector<uint32_t> &objects) {
     uint64_t n = 0;
     for (uint32_t o : objects) n += scene.objects[o].triEnd - scene.objects[o].triBegin;
@@ -58,14 +53,14 @@ bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *
         ps.bspTree = std::make_unique<BspTree>(buildBspTree(scene));
     }
     if (s.raycast) {
-        const auto t0 = Clock::now();
+        const Stopwatch t0;
         ps.rays = std::make_unique<RayScene>();
         // The float frame's origin at the scene's center keeps float precision where the geometry is.
         const Vec3 origin = scene.bounds.empty() ? Vec3{} : scene.bounds.center();
         if (!ps.rays->build(MeshView{scene.positions.data(), scene.indices.data()}, scene.positions.size(),
                             scene.objectTriangles, origin, err))
             return false;
-        ps.raySceneBuildMs = msSince(t0);
+        ps.raySceneBuildMs = t0.ms();
         ps.effectsData = effectsDataFor(scene);
     }
     *out = std::move(ps);
@@ -95,7 +90,7 @@ bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, C
 
 ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Camera &cam, const PipelineSettings &s) {
     const Scene &scene = *ps.scene;
-    const auto tView = Clock::now();
+    const Stopwatch tView;
     ViewResult r;
     r.spec = view;
     r.camera = cam;
@@ -129,7 +124,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         } else if (!s.cells) {
             r.stages.push_back(skipped("cells", "turned off by --no-cells"));
         } else {
-            const auto t0 = Clock::now();
+            const Stopwatch t0;
             st.trianglesIn = trianglesOf(scene, objects);
             std::vector<uint32_t> visible;
             if (hasPortals) {
@@ -144,7 +139,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
                 r.cellsNote = c.note;
                 visible = std::move(c.visible);
             }
-            st.ms = msSince(t0);
+            st.ms = t0.ms();
             st.ran = true;
             if (s.audit) culls.push_back({"cells", removed(objects, visible), {}});
             objects = std::move(visible);
@@ -161,9 +156,9 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         } else if (!s.grid) {
             r.stages.push_back(skipped("grid", "turned off by --no-grid"));
         } else {
-            const auto t0 = Clock::now();
+            const Stopwatch t0;
             GridResult g = cullGrid(scene, ps.grid, cam, &objects);
-            st.ms = msSince(t0);
+            st.ms = t0.ms();
             st.ran = true;
             st.trianglesIn = trianglesOf(scene, objects);
             if (s.audit) culls.push_back({"grid", g.culled, {}});
@@ -180,9 +175,9 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         StageRecord st;
         st.name = "frustum";
         if (s.frustum) {
-            const auto t0 = Clock::now();
+            const Stopwatch t0;
             FrustumResult f = cullFrustum(scene, ps.bvh, cam, &objects);
-            st.ms = msSince(t0);
+            st.ms = t0.ms();
             st.ran = true;
             r.frustum = f.stats;
             st.trianglesIn = trianglesOf(scene, objects);
@@ -223,9 +218,9 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         StageRecord st;
         st.name = "backface";
         if (s.backface) {
-            const auto t0 = Clock::now();
+            const Stopwatch t0;
             BackfaceResult b = cullBackfaces(scene, objects, cam);
-            st.ms = msSince(t0);
+            st.ms = t0.ms();
             st.ran = true;
             r.backface = b.stats;
             lists = std::move(b.kept);
@@ -245,10 +240,10 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     {
         StageRecord st;
         st.name = "clip";
-        const auto t0 = Clock::now();
+        const Stopwatch t0;
         const std::vector<ClipBatch> batches = clipBatches(scene, lists);
         clip = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, s.clip);
-        st.ms = msSince(t0);
+        st.ms = t0.ms();
         st.ran = true;
         r.clip = clip.stats;
         st.trianglesIn = lists.size();
@@ -270,9 +265,9 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             fragmentsPerSource.assign(scene.triangleCount(), 0);
             zs.fragmentsPerSource = fragmentsPerSource.data();
         }
-        const auto t0 = Clock::now();
+        const Stopwatch t0;
         ZBufferResult z = rasterize(clip.out, cam.width, cam.height, zs);
-        st.ms = msSince(t0);
+        st.ms = t0.ms();
         st.ran = true;
         r.zbuffer = z.stats;
         r.buffer = std::move(z.buffer);
@@ -289,7 +284,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     if (ps.rays) {
         StageRecord st;
         st.name = "raycast";
-        const auto t0 = Clock::now();
+        const Stopwatch t0;
         PrimaryOptions opt;
         opt.rejectBackFaces = s.backface;
         opt.doubleSided = ps.effectsData.doubleSided.data();
@@ -297,7 +292,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         opt.tiesToLowestId = true;
         opt.keepBarycentrics = ps.effects.tracesRays();
         r.raycastImage = ps.rays->castPrimary(cam, opt, &r.raycast);
-        st.ms = msSince(t0);
+        st.ms = t0.ms();
         st.ran = true;
         r.raycastRan = true;
         st.trianglesIn = scene.objectTriangles.size();
@@ -324,10 +319,10 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // that is in fact visible (false culls) or kept that is visible nowhere (wasted draws).
     if (stopped()) return r;
     if (s.audit) {
-        const auto t0 = Clock::now();
+        const Stopwatch t0;
         r.reference = referenceVisibility(scene, cam);
         r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource);
-        r.auditMs = msSince(t0);
+        r.auditMs = t0.ms();
         r.auditRan = true;
     } else {
         r.auditReason = "turned off by --no-audit";
@@ -356,14 +351,14 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // the triangles the z-buffer drew.
     if (stopped()) return r;
     if (s.zfight) {
-        const auto t0 = Clock::now();
+        const Stopwatch t0;
         r.zfight = analyzeZFighting(scene, cam, clip.out, s.zfightSettings);
-        r.zfightMs = msSince(t0);
+        r.zfightMs = t0.ms();
         r.zfightRan = true;
     } else {
         r.zfightReason = "turned off by --no-zfight";
     }
-    r.totalMs = msSince(tView);
+    r.totalMs = tView.ms();
     return r;
 }
 

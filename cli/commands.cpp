@@ -35,6 +35,7 @@
 #include "reports/html.h"
 #include "reports/merge.h"
 #include "reports/report.h"
+#include "render/stopwatch.h"
 
 namespace va {
 
@@ -258,7 +259,8 @@ int analyzeToReport(const Options &o,
                     const std::function<bool(const std::vector<ViewSpec> &, std::string *)> &beforeRun,
                     nlohmann::ordered_json *report) {
     using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
+    const auto t0 = Clock::now();  // progress lines (real time)
+    const Stopwatch loadTime;       // the report's load_ms
     installInterruptHandlers();
     PipelineSettings settings;
     if (!makeSettings(o, &settings)) return kExitBadInput;
@@ -266,7 +268,7 @@ int analyzeToReport(const Options &o,
     std::vector<ViewSpec> views;
     if (!loadInputs(o, &scene, &views)) return kExitBadInput;
     if (interrupted()) return interruptedExit(o.out);
-    const double loadMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    const double loadMs = loadTime.ms();
 
     std::string err;
     // Image names are fixed over the full view list before any selection or parallel run, so
@@ -306,14 +308,13 @@ int analyzeToReport(const Options &o,
     const bool tty = isatty(fileno(stderr));
     std::atomic<int> done{0};
     std::mutex printMutex;
-    auto msSince = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
     std::vector<double> imagesMs(views.size(), 0.0);  // per view: each slot written by one worker
     auto onView = [&](size_t i, ViewResult &v, std::string *e) {
         v.index = indices[i];
         v.imageBase = bases[i];
-        const auto w0 = Clock::now();
+        const Stopwatch w0;
         if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
-        imagesMs[i] = msSince(w0);
+        imagesMs[i] = w0.ms();
         releasePixelBuffers(v);  // the images hold them now
         const int k = ++done;
         if (!o.quiet) {
@@ -341,20 +342,20 @@ int analyzeToReport(const Options &o,
     result.loadMs = loadMs;
     OutputTimings outputMs;
     for (double ms : imagesMs) outputMs.imagesMs += ms;
-    const auto r0 = Clock::now();
+    const Stopwatch r0;
     *report = reportJson(result);
-    outputMs.reportMs = msSince(r0);
+    outputMs.reportMs = r0.ms();
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was. A signal is honoured up to the
     // commit; the swap itself is not interrupted (the handler only sets a flag), and a run whose
     // report is in place has finished. report.html is written first so that report.json can say
     // how long it took.
-    const auto h0 = Clock::now();
+    const Stopwatch h0;
     if (!writeReportHtml(*report, out.staging(), &err)) {
         fail(err);
         return kExitBadInput;
     }
-    outputMs.htmlMs = msSince(h0);
+    outputMs.htmlMs = h0.ms();
     addOutputTimings(report, outputMs);
     if (!writeFileAtomic(out.staging() + "/report.json", report->dump(2) + "\n", &err)) {
         fail(err);

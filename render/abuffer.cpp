@@ -2,9 +2,10 @@
 #include "render/abuffer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
+
+#include "render/stopwatch.h"
 
 namespace va {
 
@@ -21,7 +22,7 @@ const SampleOffset *abufferSampleOffsets() { return kGrid; }
 
 ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height, bool orthographic,
                              const ABufferMaterials &mat, uint32_t maxListLength) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch t0;
     ABufferResult r;
     r.width = std::max(width, 0);
     r.height = std::max(height, 0);
@@ -168,7 +169,7 @@ ABufferResult resolveABuffer(const ScreenTriangles &tris, int width, int height,
         }
     }
     r.averageListLength = r.coveredPixels ? double(r.fragments) / double(r.coveredPixels) : 0;
-    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.ms = t0.ms();
     return r;
 }
 

@@ -1,11 +1,12 @@
 #include "render/effects.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "render/stopwatch.h"
 
 namespace va {
 
@@ -277,7 +278,7 @@ struct Tracer {
 
 EffectsResult traceEffects(const RayScene &scene, const Camera &cam, const RaycastImage &primary,
                            const EffectsInput &in) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch t0;
     EffectsResult out;
     auto fail = [&](std::string msg) {
         out.ok = false;
@@ -365,7 +366,7 @@ EffectsResult traceEffects(const RayScene &scene, const Camera &cam, const Rayca
             out.lights[l].facingAwayPixels += r.lights[l].facingAwayPixels;
         }
     }
-    s.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    s.ms = t0.ms();
     return out;
 }
 

@@ -2,15 +2,14 @@
 #include "render/scanline.h"
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 
 #include "render/raster_core.h"
+#include "render/stopwatch.h"
 
 namespace va {
 
 namespace {
-using Clock = std::chrono::steady_clock;
 
 // A triangle ready for the row sweep: oriented (positive area), its box of centers, its plane.
 struct Prepared {
@@ -34,7 +33,7 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
 
     // Edge table: every triangle that can cover a center, bucketed by its first row (the same
     // skips as raster_core.h's walk, in its order: empty box, range, zero area, invalid plane).
-    const auto t0 = Clock::now();
+    const Stopwatch t0;
     std::vector<Prepared> prepared;
     for (size_t t = 0; t < tris.size(); ++t) {
         const int32_t *v = tris.xy.data() + 6 * t;
@@ -74,13 +73,13 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
         for (uint32_t i = 0; i < prepared.size(); ++i) byRow[fill[size_t(prepared[i].by0)]++] = i;
     }
     r.trianglesActive = prepared.size();
-    r.buildMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    r.buildMs = t0.ms();
 
     // The sweep. Per row: add the triangles starting here, drop those that ended, solve each
     // active triangle's span of covered centers, then resolve: a center inside one span takes it
     // without a depth evaluation; where spans overlap, the depths at the center decide (LESS, ties
     // to the lowest source id).
-    const auto t1 = Clock::now();
+    const Stopwatch t1;
     std::vector<uint32_t> active;
     struct Span {
         int64_t x0, x1;
@@ -162,7 +161,7 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
     r.memoryBytes = prepared.size() * sizeof(Prepared) + rowStart.size() * sizeof(uint32_t) +
                     byRow.size() * sizeof(uint32_t) + maxActive * sizeof(uint32_t) + maxSpans * sizeof(Span) +
                     rowId.size() * sizeof(uint32_t) + rowD.size() * sizeof(double) + cover.size() * sizeof(int32_t);
-    r.ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+    r.ms = t1.ms();
     return r;
 }
 
