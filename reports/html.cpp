@@ -1468,4 +1468,6 @@ bool writeReportHtml(const nlohmann::ordered_json &report, const std::string &di
     return writeFileAtomic(dir + "/report.html", reportHtml(report, dir), err);
 }
 
+std::string htmlEscape(std::string_view text) { return esc(text); }
+
 }  // namespace va
