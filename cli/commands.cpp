@@ -261,10 +261,13 @@ int cmdInfo(const Options &o) {
 
 // Runs `analyze` as the options say and writes the report folder. `beforeRun` (optional) sees the
 // views after loading and may refuse them (check validates its budget there, before any work);
-// `report` receives the report JSON. Returns an exit code.
+// `afterRun` (optional) gets the scene and the staging folder once the views are analysed, before
+// the report is written, and returns an exit code (check runs the PVS audit there); `report`
+// receives the report JSON. Returns an exit code.
+using AfterRun = std::function<int(const Scene &, const std::string &staging)>;
 int analyzeToReport(const Options &o,
                     const std::function<bool(const std::vector<ViewSpec> &, std::string *)> &beforeRun,
-                    nlohmann::ordered_json *report) {
+                    nlohmann::ordered_json *report, const AfterRun &afterRun = nullptr) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();  // progress lines (real time)
     const Stopwatch loadTime;       // the report's load_ms
@@ -346,6 +349,8 @@ int analyzeToReport(const Options &o,
         return kExitBadInput;
     }
     if (tty && !o.quiet) std::fprintf(stderr, "\n");
+    if (afterRun)
+        if (const int code = afterRun(scene, out.staging()); code != kExitOk) return code;
     result.loadMs = loadMs;
     OutputTimings outputMs;
     for (double ms : imagesMs) outputMs.imagesMs += ms;
@@ -406,44 +411,6 @@ int analyzeToReport(const Options &o,
 int cmdAnalyze(const Options &o) {
     nlohmann::ordered_json report;
     return analyzeToReport(o, nullptr, &report);
-}
-
-int cmdCheck(const Options &o) {
-    Budget budget;
-    nlohmann::ordered_json baseline;
-    std::string err;
-    if (!o.baseline.empty()) {
-        std::string detail;
-        const JsonRead r = readJsonDocument(o.baseline, &baseline, &detail);
-        if (r == JsonRead::unreadable) {
-            fail("--baseline " + o.baseline + ": cannot be read; give the report.json of an earlier analyze run");
-            return kExitBadInput;
-        }
-        if (r == JsonRead::invalid) {
-            fail("--baseline " + o.baseline + ": not valid JSON (" + detail + ")");
-            return kExitBadInput;
-        }
-    }
-    // The budget is validated against the views before anything is analysed.
-    auto validate = [&](const std::vector<ViewSpec> &views, std::string *e) {
-        std::vector<std::string> names;
-        for (const ViewSpec &v : views) names.push_back(v.name);
-        return loadBudget(o.budget, names, &budget, e);
-    };
-    nlohmann::ordered_json report;
-    const int code = analyzeToReport(o, validate, &report);
-    if (code != kExitOk) return code;
-    BudgetResult result;
-    if (!evaluateBudget(budget, report, o.baseline.empty() ? nullptr : &baseline, &result, &err)) {
-        fail(err);
-        return kExitBadInput;
-    }
-    std::printf("%s", budgetTable(result).c_str());
-    if (!o.junit.empty() && !writeFileAtomic(o.junit, budgetJUnit(result, report["scene"]["path"]), &err)) {
-        fail(err);
-        return kExitBadInput;
-    }
-    return result.failed ? kExitBudgetFailed : kExitOk;
 }
 
 // ---- pvs-audit (docs/pvs-audit.md) ------------------------------------------------------------
@@ -602,6 +569,71 @@ void addPvsAuditOptions(CLI::App *c, Options &o) {
         ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
     c->add_flag("--json", o.json, "Print the totals as JSON on stdout");
+}
+
+int cmdCheck(const Options &o) {
+    Budget budget;
+    nlohmann::ordered_json baseline;
+    std::string err;
+    if (!o.baseline.empty()) {
+        std::string detail;
+        const JsonRead r = readJsonDocument(o.baseline, &baseline, &detail);
+        if (r == JsonRead::unreadable) {
+            fail("--baseline " + o.baseline + ": cannot be read; give the report.json of an earlier analyze run");
+            return kExitBadInput;
+        }
+        if (r == JsonRead::invalid) {
+            fail("--baseline " + o.baseline + ": not valid JSON (" + detail + ")");
+            return kExitBadInput;
+        }
+    }
+    // The budget is validated against the views before anything is analysed.
+    auto validate = [&](const std::vector<ViewSpec> &views, std::string *e) {
+        std::vector<std::string> names;
+        for (const ViewSpec &v : views) names.push_back(v.name);
+        return loadBudget(o.budget, names, &budget, e);
+    };
+    // A budget naming pvs_* runs the PVS audit on the map too; its files go next to report.json.
+    nlohmann::ordered_json pvsAudit;
+    auto pvs = [&](const Scene &scene, const std::string &staging) {
+        if (!budgetNeedsPvsAudit(budget)) return int(kExitOk);
+        if (const char *why = pvsAuditSkipReason(scene)) {
+            fail("--budget " + o.budget + " names a pvs_* metric, which needs the PVS audit: " + scene.path + ": " + why +
+                 "; check a Quake 3 map, or leave pvs_* out of the budget");
+            return int(kExitBadInput);
+        }
+        PvsAuditSettings s;
+        if (!pvsSettings(o, &s)) return int(kExitBadInput);
+        PvsAuditResult r;
+        return runPvsAudit(o, scene, s, staging, o.out, &r, &pvsAudit);
+    };
+    nlohmann::ordered_json report;
+    const int code = analyzeToReport(o, validate, &report, pvs);
+    if (code != kExitOk) return code;
+    BudgetResult result;
+    if (!evaluateBudget(budget, report, o.baseline.empty() ? nullptr : &baseline, &result, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (budgetNeedsPvsAudit(budget)) {
+        // The baseline's audit: pvs-audit.json next to the baseline's report.json (absent: no baseline).
+        nlohmann::ordered_json basePvs;
+        bool haveBase = false;
+        if (!o.baseline.empty()) {
+            const std::string p = (std::filesystem::path(o.baseline).parent_path() / "pvs-audit.json").string();
+            haveBase = readJsonDocument(p, &basePvs, nullptr) == JsonRead::ok;
+        }
+        if (!evaluatePvsBudget(budget, pvsAudit, haveBase ? &basePvs : nullptr, &result, &err)) {
+            fail(err);
+            return kExitBadInput;
+        }
+    }
+    std::printf("%s", budgetTable(result).c_str());
+    if (!o.junit.empty() && !writeFileAtomic(o.junit, budgetJUnit(result, report["scene"]["path"]), &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    return result.failed ? kExitBudgetFailed : kExitOk;
 }
 
 void addAnalyzeOptions(CLI::App *c, Options &o);

@@ -358,8 +358,14 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
     std::string o;
     const std::string map = text(a, {"map"});
     const double misses = num(a, {"totals", "misses"}), slack = num(a, {"totals", "slack_share"});
-    o += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>visaudit PVS audit: " + htmlEscape(map) +
-         "</title><style>" + std::string(html_assets::kCss) + "</style></head><body>\n";
+    // The same head as report.html: nothing may load from elsewhere.
+    o += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+         "<meta name=\"color-scheme\" content=\"light dark\">"
+         "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src 'self' file: data:; "
+         "style-src 'unsafe-inline'\">"
+         "<title>visaudit PVS audit: " + htmlEscape(map) + "</title><style>" + std::string(html_assets::kCss) +
+         "</style></head><body>\n";
     o += "<header><h1>PVS audit: " + htmlEscape(map) + "</h1><p class=\"meta\">visaudit " +
          htmlEscape(text(a, {"tool", "version"})) + " · " + htmlEscape(text(a, {"format"})) + "</p>";
     o += std::string("<p class=\"verdict ") + (misses > 0 ? "bad" : "good") + "\"><b>" + count(uint64_t(misses)) +
