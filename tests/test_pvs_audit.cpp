@@ -517,3 +517,28 @@ TEST_F(PvsAuditTest, CheckGatesOnPvsMisses) {
     EXPECT_NE(bad.err.find("'pvs_misses' is one number for the whole map (the PVS audit), not per view"), std::string::npos)
         << bad.err;
 }
+
+// docs/pvs-audit.md names every key pvs-audit.json writes (as `key`), so the page a reader follows
+// never lags the file.
+TEST_F(PvsAuditTest, DocsNameEveryJsonKey) {
+    const Scene s = loadCorridor(fiveRooms(), dir_);
+    PvsAuditSettings st;
+    st.samples = 4;
+    st.resolution = 4;
+    const nlohmann::ordered_json j = pvsAuditJson(audit(s, st), "pvs-audit.png");
+    const std::string doc = slurp(fs::path(VISAUDIT_SOURCE_DIR) / "docs" / "pvs-audit.md");
+    ASSERT_FALSE(doc.empty());
+    auto keysOf = [&](const nlohmann::ordered_json &o, const std::string &where) {
+        ASSERT_TRUE(o.is_object()) << where;
+        for (const auto &[k, v] : o.items()) EXPECT_NE(doc.find("`" + k + "`"), std::string::npos) << where << "." << k;
+    };
+    keysOf(j, "top");
+    for (const char *k : {"settings", "far_plane", "definition", "occluders", "totals", "histograms", "worst", "timings_ms"})
+        keysOf(j[k], k);
+    keysOf(j["clusters"][0], "clusters[]");
+    ASSERT_FALSE(j["misses"].empty());
+    keysOf(j["misses"][0], "misses[]");
+    ASSERT_FALSE(j["worst"]["slack"].empty());
+    keysOf(j["worst"]["slack"][0], "worst.slack[]");
+    keysOf(j["histograms"]["misses"][0], "histograms.misses[]");
+}
