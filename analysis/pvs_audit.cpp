@@ -211,6 +211,7 @@ constexpr uint8_t kWithin = 1, kBeyond = 2, kPlayer = 4;
 struct Scratch {
     std::vector<uint8_t> flag;        // per cluster: kWithin | kBeyond | kPlayer
     std::vector<uint64_t> rays;       // per cluster: rays that saw it within the far plane
+    std::vector<uint64_t> lastRay;    // per cluster: 1 + the index of the last ray that did (0: none yet)
     std::vector<int32_t> evidence;    // per cluster: index into misses, -1 none
     std::vector<int32_t> touched;
     std::vector<int32_t> updated;
@@ -341,6 +342,7 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
             double stopT = tEnd;
             int32_t stopLeaf = -1;
             sc.updated.clear();  // misses whose evidence this ray (re)wrote
+            const uint64_t rayId = uint64_t(si) * nd + i + 1;
             walk(lv, eye, dirs[i], tEnd, sc.stack, [&](int32_t leaf, double a, double b) {
                 const int32_t t = lv.leafs[size_t(leaf)].cluster;
                 if (t < 0) {
@@ -350,7 +352,7 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
                 if (std::min(b, F) - a > tol) {  // seen within the far plane
                     touch(t);
                     uint8_t &f = sc.flag[size_t(t)];
-                    ++sc.rays[size_t(t)];
+                    if (sc.lastRay[size_t(t)] != rayId) sc.lastRay[size_t(t)] = rayId, ++sc.rays[size_t(t)];
                     // Evidence for a hidden cluster: the first ray that saw it, replaced once by the first
                     // from an eye point where a player's eye can be.
                     if (!cx.pvsBit(c, t) && (!(f & kWithin) || (player && !(f & kPlayer)))) {
@@ -405,7 +407,7 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
             ++r.seenBeyondFar;
             r.hiddenByFarPlane += !bit;
         }
-        sc.flag[size_t(t)] = 0, sc.rays[size_t(t)] = 0, sc.evidence[size_t(t)] = -1;
+        sc.flag[size_t(t)] = 0, sc.rays[size_t(t)] = 0, sc.lastRay[size_t(t)] = 0, sc.evidence[size_t(t)] = -1;
     }
     r.slack = r.pvsVisible - seenVisible;  // visible in the row, never seen
 }
@@ -635,6 +637,7 @@ bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out
         if (sc.flag.size() != size_t(lv.clusterCount)) {
             sc.flag.assign(size_t(lv.clusterCount), 0);
             sc.rays.assign(size_t(lv.clusterCount), 0);
+            sc.lastRay.assign(size_t(lv.clusterCount), 0);
             sc.evidence.assign(size_t(lv.clusterCount), -1);
         }
         sc.sampleMs = sc.castMs = sc.walkMs = 0;

@@ -221,6 +221,7 @@ TEST_F(PvsAuditTest, MissEvidenceIsTheRayThatSawIt) {
     EXPECT_EQ(m.pvsBit, 1);
     EXPECT_EQ(m.pvsByteValue, 0x0D);
     EXPECT_GE(m.rays, 1u);
+    EXPECT_LE(m.rays, a.rays);  // counted once per ray, however many of its leafs it crossed
     // C (2) sees A (0) through the quad's back face: the ray crossed x = 150 and x = 100 going -x.
     const PvsClusterAudit &c = clusterOf(r, 2);
     ASSERT_EQ(c.missList.size(), 1u);
