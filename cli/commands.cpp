@@ -435,8 +435,9 @@ bool parseClusterList(const std::string &text, std::vector<int32_t> *out, std::s
                    "' is not a cluster or a range A-B (A <= B); give e.g. --clusters 0-99,200";
             return false;
         }
-        if (b - a > 100000000) {
-            *err = "--clusters " + text + ": the range '" + part + "' is larger than any map";
+        if (b >= (1 << 20)) {
+            *err = "--clusters " + text + ": '" + part + "' goes past cluster 1048575, more than any map has "
+                   "(Quake 3 allows 131072 leafs)";
             return false;
         }
         for (int64_t c = a; c <= b; ++c) out->push_back(int32_t(c));
@@ -552,17 +553,17 @@ void addPvsAuditOptions(CLI::App *c, Options &o) {
     c->add_option("map", o.scene, "Quake 3 map: x.bsp or pak.pk3:maps/x.bsp")->required();
     c->add_option("--out", o.pvsOut, "Output folder for pvs-audit.json, .png and .html (written as a whole or not at all)");
     c->add_option("--samples", o.pvs.samples, "Eye points per cluster (default 32; time grows linearly)")
-        ->check(CLI::Range(1, 65536));
+        ->check(CLI::Range(1, 1024));
     c->add_option("--resolution", o.pvs.resolution,
                   "Cube-face side: 6 x R^2 rays per eye point (default 16: 1536 rays; time grows with R^2)")
-        ->check(CLI::Range(1, 1024));
+        ->check(CLI::Range(1, 256));
     c->add_option("--seed", o.pvs.seed, "Seed of the eye points and ray rotations (default 1)");
     c->add_option_function<double>("--far-plane", [&o](double d) { o.pvsFar = d; },
                                    "Far plane distance (default: the map's _farplanedist; 0 = unlimited)")
         ->check(CLI::Range(0.0, 1e30));
     c->add_option("--clusters", o.pvsClusters, "Audit only these clusters, e.g. 0-99,200 (default: every cluster)");
-    c->add_option("--image-size", o.pvs.imageSize, "Longest side of pvs-audit.png in pixels (0 = no image)")
-        ->check(CLI::Range(0, 16384));
+    c->add_option("--image-size", o.pvs.imageSize, "Longest side of pvs-audit.png in pixels (default 1024; 0 = no image)")
+        ->check(CLI::Range(0, 4096));
     c->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
     c->add_option("--patch-level", o.patchLevel, "Segments per Bezier patch edge (patches occlude)")->check(CLI::Range(1, 64));
     c->add_option("--max-triangles", o.maxTriangles, "Largest map accepted, in triangles")
