@@ -34,20 +34,42 @@ constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
 
 // ---- The walk -----------------------------------------------------------------------------------
 
+// The tree as the walk reads it: each node with its plane inline (one memory access per node).
+struct FlatNode {
+    Vec3 normal;
+    double dist;
+    int32_t children[2];
+};
+std::vector<FlatNode> flatNodes(const BspLevel &lv) {
+    std::vector<FlatNode> f(lv.nodes.size());
+    for (size_t i = 0; i < f.size(); ++i) {
+        const BspPlane &pl = lv.planes[lv.nodes[i].plane];
+        f[i] = {pl.normal, pl.dist, {lv.nodes[i].children[0], lv.nodes[i].children[1]}};
+    }
+    return f;
+}
+// Per node, dot(n, eye) - dist: the same for every ray from one eye, computed once per eye point.
+void nodeDistances(const std::vector<FlatNode> &nodes, Vec3 eye, std::vector<double> *at) {
+    at->resize(nodes.size());
+    for (size_t i = 0; i < nodes.size(); ++i) (*at)[i] = dot(nodes[i].normal, eye) - nodes[i].dist;
+}
+
 // Front-to-back walk of the segment eye + t dir, t in [0, tEnd] (Quake 3's CM_TraceThroughTree
-// without the recursion). A node's plane splits the segment where dot(n, p) - dist changes sign;
-// the side holding the segment's start is walked first and the other part is pushed. The side of a
-// point is leafAt's: dot(n, p) - dist >= 0 is the front, so the first leaf is leafAt(eye). The stack
-// holds at most one entry per node on the current path (the tree's depth); nodes come after their
-// parents (checked when loading), so every path ends.
+// without the recursion). A node's plane splits the segment where dot(n, p) - dist = at + rate t
+// changes sign (at: the eye's value, from nodeDistances; rate = dot(n, dir)); the side holding the
+// segment's start is walked first and the other part is pushed. The side of a point is leafAt's:
+// dot(n, p) - dist >= 0 is the front, so the first leaf is leafAt(eye). The stack holds at most one
+// entry per node on the current path (the tree's depth); nodes come after their parents (checked
+// when loading), so every path ends.
 struct Segment {
     int32_t node;
     double t0, t1;
 };
 template <class LeafFn>
-void walk(const BspLevel &lv, Vec3 eye, Vec3 dir, double tEnd, std::vector<Segment> &stack, LeafFn &&leaf) {
-    if (lv.leafs.empty()) return;
-    if (lv.nodes.empty()) {
+void walk(const std::vector<FlatNode> &nodes, const double *eyeAt, bool noLeafs, Vec3 dir, double tEnd,
+          std::vector<Segment> &stack, LeafFn &&leaf) {
+    if (noLeafs) return;
+    if (nodes.empty()) {
         leaf(0, 0.0, tEnd);
         return;
     }
@@ -58,9 +80,8 @@ void walk(const BspLevel &lv, Vec3 eye, Vec3 dir, double tEnd, std::vector<Segme
         stack.pop_back();
         int32_t n = s.node;
         while (n >= 0) {
-            const BspNode &node = lv.nodes[size_t(n)];
-            const BspPlane &pl = lv.planes[node.plane];
-            const double at = dot(pl.normal, eye) - pl.dist, rate = dot(pl.normal, dir);
+            const FlatNode &node = nodes[size_t(n)];
+            const double at = eyeAt[n], rate = dot(node.normal, dir);
             const double d0 = at + rate * s.t0, d1 = at + rate * s.t1;
             if (d0 >= 0 && d1 >= 0) {
                 n = node.children[0];
@@ -184,6 +205,7 @@ struct Context {
     Vec3 origin;
     double diagonal = 0, farPlane = 0, tolerance = 0;
     std::vector<uint32_t> clusterLeafsBegin, clusterLeafs;  // CSR: leafs of the tree per cluster
+    std::vector<FlatNode> nodes;
     std::vector<Vec3> dirs;
     Context(const Scene &sc, const PvsAuditSettings &st) : scene(sc), lv(*sc.bsp), s(st) {}
 
@@ -219,6 +241,7 @@ struct Scratch {
     std::vector<Vec3> dirs;
     std::vector<LocalHit> hits;
     std::vector<Segment> stack;
+    std::vector<double> eyeAt;        // per node: the eye point's dot(n, eye) - dist
     std::vector<int32_t> boxStack;
     std::vector<double> weights;
     std::vector<PvsMiss> misses;
@@ -317,6 +340,7 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
         const bool player = r.playerEye[si];
         const int32_t eyeLeaf = lv.leafAt(eye);
         const Rotation rot = Rotation::random(rng);
+        nodeDistances(cx.nodes, eye, &sc.eyeAt);
         const auto c0 = Clock::now();
         const Vec3 rel = eye - cx.origin;
         std::vector<Vec3> &dirs = sc.dirs;  // this eye point's directions (double, unit)
@@ -343,7 +367,7 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
             int32_t stopLeaf = -1;
             sc.updated.clear();  // misses whose evidence this ray (re)wrote
             const uint64_t rayId = uint64_t(si) * nd + i + 1;
-            walk(lv, eye, dirs[i], tEnd, sc.stack, [&](int32_t leaf, double a, double b) {
+            walk(cx.nodes, sc.eyeAt.data(), lv.leafs.empty(), dirs[i], tEnd, sc.stack, [&](int32_t leaf, double a, double b) {
                 const int32_t t = lv.leafs[size_t(leaf)].cluster;
                 if (t < 0) {
                     stop = PvsStop::solid, stopT = a, stopLeaf = leaf;
@@ -498,7 +522,10 @@ bool playerEyeFits(const BspLevel &level, Vec3 eye) {
 void walkBspSegment(const BspLevel &level, Vec3 eye, Vec3 dir, double tEnd,
                     const std::function<bool(int32_t, double, double)> &leaf) {
     std::vector<Segment> stack;
-    walk(level, eye, dir, tEnd, stack, leaf);
+    const std::vector<FlatNode> nodes = flatNodes(level);
+    std::vector<double> at;
+    nodeDistances(nodes, eye, &at);
+    walk(nodes, at.data(), level.leafs.empty(), dir, tEnd, stack, leaf);
 }
 
 bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out, std::string *err) {
@@ -610,6 +637,7 @@ bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out
                        cx.origin, err))
         return false;
     cx.dirs = cubeDirections(s.resolution);
+    cx.nodes = flatNodes(lv);
     // The clusters to audit.
     std::vector<int32_t> todo = s.clusters;
     if (todo.empty())

@@ -50,7 +50,7 @@ namespace va {
 
 struct PvsAuditSettings {
     int samples = 32;             // eye points per cluster (--samples)
-    int resolution = 16;          // cube-face side: rays per eye point = 6 * resolution^2 (--resolution)
+    int resolution = 12;          // cube-face side: rays per eye point = 6 * resolution^2 (--resolution)
     uint64_t seed = 1;            // --seed
     double farPlane = -1;         // < 0: the map's own (_farplanedist); 0: unlimited; > 0: this distance
     std::vector<int32_t> clusters;  // the clusters to audit, ascending; empty: every cluster

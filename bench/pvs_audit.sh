@@ -35,6 +35,6 @@ for settings in "default:" "quick:--samples 16 --resolution 8" "thorough:--sampl
   if [ "$name" = default ]; then
     verdict=$(echo "$wall <= 60" | bc -l | sed 's/1/PASS (<= 60 s)/; s/^0$/FAIL (> 60 s)/')
   fi
-  printf '%-42s %9.1f %12s %10.2f  %s %s\n' "$name ${flags:-(32 x 1536 rays)}" "$wall" "$rays" \
+  printf '%-42s %9.1f %12s %10.2f  %s %s\n' "$name ${flags:-(32 x 864 rays)}" "$wall" "$rays" \
     "$(echo "$rays / $wall / 1000000" | bc -l)" "$split" "$verdict"
 done

@@ -555,7 +555,7 @@ void addPvsAuditOptions(CLI::App *c, Options &o) {
     c->add_option("--samples", o.pvs.samples, "Eye points per cluster (default 32; time grows linearly)")
         ->check(CLI::Range(1, 1024));
     c->add_option("--resolution", o.pvs.resolution,
-                  "Cube-face side: 6 x R^2 rays per eye point (default 16: 1536 rays; time grows with R^2)")
+                  "Cube-face side: 6 x R^2 rays per eye point (default 12: 864 rays; time grows with R^2)")
         ->check(CLI::Range(1, 256));
     c->add_option("--seed", o.pvs.seed, "Seed of the eye points and ray rotations (default 1)");
     c->add_option_function<double>("--far-plane", [&o](double d) { o.pvsFar = d; },

@@ -369,8 +369,12 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
     o += "<header><h1>PVS audit: " + htmlEscape(map) + "</h1><p class=\"meta\">visaudit " +
          htmlEscape(text(a, {"tool", "version"})) + " · " + htmlEscape(text(a, {"format"})) + "</p>";
     o += std::string("<p class=\"verdict ") + (misses > 0 ? "bad" : "good") + "\"><b>" + count(uint64_t(misses)) +
-         " misses</b> (cluster pairs seen although the PVS says hidden; best 0) · <b>" + percent(slack) +
-         " slack</b> (PVS-visible pairs no eye point saw)</p></header>\n";
+         " misses</b> (cluster pairs a player's eye sees although the PVS says hidden; best 0) · <b>" + percent(slack) +
+         " slack</b> (PVS-visible pairs no eye point saw)" +
+         (num(a, {"totals", "crack_misses"}) > 0
+              ? " · " + count(uint64_t(num(a, {"totals", "crack_misses"}))) + " crack misses (seen only where no player fits)"
+              : std::string()) +
+         "</p></header>\n";
     // Totals, each with its meaning.
     struct Row {
         const char *key, *meaning;

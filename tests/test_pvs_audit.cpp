@@ -160,7 +160,7 @@ TEST_F(PvsAuditTest, FiveRoomsKnownMissesCrackMissAndSlack) {
         EXPECT_EQ(a.misses, want[c].misses);
         EXPECT_EQ(a.crackMisses, want[c].crackMisses);
         EXPECT_EQ(a.slack, want[c].slack);
-        EXPECT_EQ(a.rays, 32u * 1536u);
+        EXPECT_EQ(a.rays, 32u * 864u);
     }
     // E is 5 units deep against a solid wall: no crouching player's box fits; the rooms have room.
     EXPECT_EQ(clusterOf(r, 4).playerSamples, 0u);
