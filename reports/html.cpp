@@ -5,6 +5,7 @@
 //   summary      one row per view, worst first, each linking to its section
 //   planner      the report-level "effects" decisions (when present)
 //   depth audit  depth-audit.png when the folder holds one
+//   PVS audit    a link to pvs-audit.html and its image when the folder holds them (check, pvs_*)
 //   per view     camera line; the six questions of visibility; the stage funnel (SVG) and stage
 //                table; images with legends (click to enlarge); z-fighting hotspots (rows link to
 //                boxes over the z-fight image); false culls; ray-cast cross-check; depth formats
