@@ -100,6 +100,7 @@ private:
     bool leafs(BspLevel *level);
     bool visdata(BspLevel *level);
     bool faces(std::vector<Face> *out);
+    bool brushes(BspLevel *level);
 };
 
 // ---- 1. Header --------------------------------------------------------------------------------------
@@ -224,6 +225,8 @@ bool Parser::leafs(BspLevel *level) {
                                         str(int64_t(count_[kLeafBrushes])) + " leafbrushes; the file is damaged");
         l.firstLeafFace = uint32_t(lf);
         l.leafFaceCount = uint32_t(nlf);
+        l.firstLeafBrush = uint32_t(lb);
+        l.leafBrushCount = uint32_t(nlb);
     }
     // leafface: int face (4 bytes)
     level->leafFaces.resize(count_[kLeafFaces]);
@@ -268,6 +271,57 @@ bool Parser::visdata(BspLevel *level) {
     level->clusterCount = n;
     level->pvsRowBytes = uint32_t(sz);
     level->pvs.assign(p + 8, p + 8 + need);
+    return true;
+}
+
+// Shaders, leafbrushes, brushes and brush sides, kept for the PVS audit (a point inside a detail
+// brush is inside solid although its leaf has a cluster).
+bool Parser::brushes(BspLevel *level) {
+    // shader: char name[64], int surfaceFlags, int contents (72 bytes)
+    level->shaders.resize(count_[kShaders]);
+    for (uint64_t i = 0; i < count_[kShaders]; ++i) {
+        const uint8_t *p = rec(kShaders, i);
+        BspShader &sh = level->shaders[i];
+        const char *name = reinterpret_cast<const char *>(p);
+        sh.name.assign(name, std::find(name, name + 64, '\0'));
+        sh.surfaceFlags = u32(p + 64);
+        sh.contents = u32(p + 68);
+    }
+    // brushside: int plane, int shader (8 bytes)
+    level->brushSides.resize(count_[kBrushSides]);
+    for (uint64_t i = 0; i < count_[kBrushSides]; ++i) {
+        const int32_t plane = i32(rec(kBrushSides, i)), shader = i32(rec(kBrushSides, i) + 4);
+        if (plane < 0 || uint64_t(plane) >= count_[kPlanes])
+            return lumpFail(kBrushSides, "brush side " + str(int64_t(i)) + " plane " + str(plane) + " is outside the " +
+                                             str(int64_t(count_[kPlanes])) + " planes; the file is damaged");
+        if (shader < 0 || uint64_t(shader) >= count_[kShaders])
+            return lumpFail(kBrushSides, "brush side " + str(int64_t(i)) + " shader " + str(shader) +
+                                             " is outside the " + str(int64_t(count_[kShaders])) +
+                                             " shaders; the file is damaged");
+        level->brushSides[i] = uint32_t(plane);
+    }
+    // brush: int brushside, int n_brushsides, int shader (12 bytes)
+    level->brushes.resize(count_[kBrushes]);
+    for (uint64_t i = 0; i < count_[kBrushes]; ++i) {
+        const uint8_t *p = rec(kBrushes, i);
+        const int32_t side = i32(p), n = i32(p + 4), shader = i32(p + 8);
+        if (!inRange(side, n, count_[kBrushSides]))
+            return lumpFail(kBrushes, "brush " + str(int64_t(i)) + " side range " + range(side, n) + " exceeds the " +
+                                          str(int64_t(count_[kBrushSides])) + " brush sides; the file is damaged");
+        if (shader < 0 || uint64_t(shader) >= count_[kShaders])
+            return lumpFail(kBrushes, "brush " + str(int64_t(i)) + " shader " + str(shader) + " is outside the " +
+                                          str(int64_t(count_[kShaders])) + " shaders; the file is damaged");
+        level->brushes[i] = {uint32_t(side), uint32_t(n), uint32_t(shader)};
+    }
+    // leafbrush: int brush (4 bytes)
+    level->leafBrushes.resize(count_[kLeafBrushes]);
+    for (uint64_t i = 0; i < count_[kLeafBrushes]; ++i) {
+        const int32_t b = i32(rec(kLeafBrushes, i));
+        if (b < 0 || uint64_t(b) >= count_[kBrushes])
+            return lumpFail(kLeafBrushes, "leafbrush " + str(int64_t(i)) + " names brush " + str(b) + ", outside the " +
+                                              str(int64_t(count_[kBrushes])) + " brushes; the file is damaged");
+        level->leafBrushes[i] = uint32_t(b);
+    }
     return true;
 }
 
@@ -377,8 +431,11 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         return fail("patch level " + str(L) + " is outside 1.." + str(kMaxPatchLevel) + "; choose e.g. 5 (--patch-level)");
     if (!header()) return false;
     std::vector<Face> fs;
-    if (!entities(level) || !planes(level) || !nodes(level) || !leafs(level) || !visdata(level) || !faces(&fs))
+    if (!entities(level) || !planes(level) || !nodes(level) || !leafs(level) || !visdata(level) || !faces(&fs) ||
+        !brushes(level))
         return false;
+    level->faceShader.resize(fs.size());
+    for (size_t i = 0; i < fs.size(); ++i) level->faceShader[i] = uint32_t(fs[i].shader);
     level->patchLevel = L;
     const uint64_t nf = fs.size();
 
@@ -445,6 +502,7 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
             return lumpFail(kModels, "model " + str(int64_t(i)) + " face range " + range(m.face, m.nFaces) +
                                          " exceeds the " + str(int64_t(nf)) + " faces; the file is damaged");
     }
+    if (!models.empty()) level->worldFirstFace = uint32_t(models[0].face), level->worldFaceCount = uint32_t(models[0].nFaces);
 
     // 4. Objects. owner[f]: the first leaf listing face f; modelOf[f]: the first model holding it.
     constexpr uint32_t kNone = 0xFFFFFFFFu;
@@ -560,6 +618,7 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
     level->sourceCluster.clear();
     level->sourceClustersBegin.assign(1, 0);
     level->sourceClusters.clear();
+    level->triangleFace.clear();
     std::vector<Vec3> ctrl;
     for (uint32_t oi : order) {
         Obj &o = objs[oi];
@@ -576,9 +635,12 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
             if (f.type == kPatch) {
                 ctrl.resize(size_t(f.width) * size_t(f.height));
                 for (size_t k = 0; k < ctrl.size(); ++k) ctrl[k] = position(uint64_t(f.vertex) + k);
+                const size_t before = m.indices.size() / 3;
                 tessellatePatch(ctrl, f.width, f.height, L, &m);
+                level->triangleFace.insert(level->triangleFace.end(), m.indices.size() / 3 - before, fi);
                 continue;
             }
+            level->triangleFace.insert(level->triangleFace.end(), size_t(f.nMeshverts / 3), fi);
             // Polygons and meshes: meshverts index the face's own vertices (offset by its first
             // vertex); each triangle is stored clockwise seen from the front, so two corners swap.
             const uint32_t base = uint32_t(m.positions.size());

@@ -101,6 +101,21 @@ struct BspLeaf {
     int32_t area = -1;
     Aabb bounds;           // as stored (integers)
     uint32_t firstLeafFace = 0, leafFaceCount = 0;  // its faces: BspLevel::leafFaces[first, first + count)
+    uint32_t firstLeafBrush = 0, leafBrushCount = 0;  // its brushes: BspLevel::leafBrushes[first, first + count)
+};
+
+// What the PVS audit (analysis/pvs_audit.h) reads besides the tree: shaders' flags, the brushes a
+// leaf holds (a detail brush does not split the tree, so a point in a leaf with a cluster can still
+// be inside solid), and where each triangle came from.
+struct BspShader {
+    std::string name;
+    uint32_t surfaceFlags = 0;  // SURF_* (Quake 3's surfaceflags.h): 0x4 sky, 0x80 nodraw, ...
+    uint32_t contents = 0;      // CONTENTS_*: 0x1 solid, 0x20 water, 0x20000000 translucent, ...
+};
+// A convex brush: the points behind (dot(normal, p) - dist <= 0) every side's plane.
+struct BspBrush {
+    uint32_t firstSide = 0, sideCount = 0;  // BspLevel::brushSides[first, first + count)
+    uint32_t shader = 0;                    // its contents are this shader's
 };
 
 // What the map's faces were, counted by kind (a face counts once, under the first rule that holds:
@@ -136,6 +151,17 @@ struct BspLevel {
     std::vector<uint32_t> sourceClustersBegin;  // size sources + 1: ranges into sourceClusters
     std::vector<int32_t> sourceClusters;
     std::vector<BspEntity> entities;
+    // For the PVS audit: every shader, brush and brush side (each side: its plane), the brushes of
+    // each leaf (ranges of leafBrushes), each face's shader, the world's faces (model 0:
+    // [worldFirstFace, worldFirstFace + worldFaceCount)), and per source triangle the face it came
+    // from (faces lump index; triangles in the scene's source order).
+    std::vector<BspShader> shaders;
+    std::vector<BspBrush> brushes;
+    std::vector<uint32_t> brushSides;       // per side: its plane
+    std::vector<uint32_t> leafBrushes;      // brush indices, ranges of it per leaf
+    std::vector<uint32_t> faceShader;
+    uint32_t worldFirstFace = 0, worldFaceCount = 0;
+    std::vector<uint32_t> triangleFace;
     BspFaceCounts faceCounts;
     int patchLevel = 0;                     // the tessellation level used (segments per patch edge)
 

@@ -27,6 +27,7 @@
 #include "analysis/limits.h"
 #include "analysis/load.h"
 #include "analysis/pipeline.h"
+#include "analysis/pvs_audit.h"
 #include "reports/console.h"
 #include "reports/depth_audit_report.h"
 #include "reports/depth_plot.h"
@@ -34,6 +35,7 @@
 #include "reports/grade.h"
 #include "reports/html.h"
 #include "reports/merge.h"
+#include "reports/pvs_audit_report.h"
 #include "reports/report.h"
 #include "render/stopwatch.h"
 
@@ -79,6 +81,11 @@ struct Options {
     std::string budget, baseline, junit;
     // grade
     std::string reference, submission, tolerance, gradeOut;
+    // pvs-audit (and check, when its budget names a pvs_* metric)
+    PvsAuditSettings pvs;
+    std::string pvsClusters;       // --clusters: "0-99,200"
+    std::optional<double> pvsFar;  // --far-plane
+    std::string pvsOut = "visaudit-pvs-audit";
 };
 
 void fail(const std::string &msg) { std::fprintf(stderr, "visaudit: error: %s\n", msg.c_str()); }
@@ -254,10 +261,13 @@ int cmdInfo(const Options &o) {
 
 // Runs `analyze` as the options say and writes the report folder. `beforeRun` (optional) sees the
 // views after loading and may refuse them (check validates its budget there, before any work);
-// `report` receives the report JSON. Returns an exit code.
+// `afterRun` (optional) gets the scene and the staging folder once the views are analysed, before
+// the report is written, and returns an exit code (check runs the PVS audit there); `report`
+// receives the report JSON. Returns an exit code.
+using AfterRun = std::function<int(const Scene &, const std::string &staging)>;
 int analyzeToReport(const Options &o,
                     const std::function<bool(const std::vector<ViewSpec> &, std::string *)> &beforeRun,
-                    nlohmann::ordered_json *report) {
+                    nlohmann::ordered_json *report, const AfterRun &afterRun = nullptr) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();  // progress lines (real time)
     const Stopwatch loadTime;       // the report's load_ms
@@ -339,6 +349,8 @@ int analyzeToReport(const Options &o,
         return kExitBadInput;
     }
     if (tty && !o.quiet) std::fprintf(stderr, "\n");
+    if (afterRun)
+        if (const int code = afterRun(scene, out.staging()); code != kExitOk) return code;
     result.loadMs = loadMs;
     OutputTimings outputMs;
     for (double ms : imagesMs) outputMs.imagesMs += ms;
@@ -401,6 +413,165 @@ int cmdAnalyze(const Options &o) {
     return analyzeToReport(o, nullptr, &report);
 }
 
+// ---- pvs-audit (docs/pvs-audit.md) ------------------------------------------------------------
+
+// --clusters "0-99,200,310-312" -> ascending, without repeats. False + message on bad text.
+bool parseClusterList(const std::string &text, std::vector<int32_t> *out, std::string *err) {
+    out->clear();
+    std::stringstream ss(text);
+    std::string part;
+    auto whole = [](const std::string &t, int64_t *v) {
+        if (t.empty() || t.size() > 9 || t.find_first_not_of("0123456789") != std::string::npos) return false;
+        *v = std::stoll(t);
+        return true;
+    };
+    while (std::getline(ss, part, ',')) {
+        const size_t dash = part.find('-');
+        int64_t a = 0, b = 0;
+        const bool ok = dash == std::string::npos ? whole(part, &a) && whole(part, &b)
+                                                  : whole(part.substr(0, dash), &a) && whole(part.substr(dash + 1), &b);
+        if (!ok || b < a) {
+            *err = "--clusters " + text + ": '" + part +
+                   "' is not a cluster or a range A-B (A <= B); give e.g. --clusters 0-99,200";
+            return false;
+        }
+        if (b >= (1 << 20)) {
+            *err = "--clusters " + text + ": '" + part + "' goes past cluster 1048575, more than any map has "
+                   "(Quake 3 allows 131072 leafs)";
+            return false;
+        }
+        for (int64_t c = a; c <= b; ++c) out->push_back(int32_t(c));
+    }
+    if (out->empty()) {
+        *err = "--clusters: empty; give clusters and ranges, e.g. --clusters 0-99,200";
+        return false;
+    }
+    std::sort(out->begin(), out->end());
+    out->erase(std::unique(out->begin(), out->end()), out->end());
+    return true;
+}
+
+// The audit's settings from the options (pvs-audit's flags; check uses the defaults).
+bool pvsSettings(const Options &o, PvsAuditSettings *s) {
+    *s = o.pvs;
+    s->threads = o.threads;
+    s->cancel = &gInterrupt;
+    if (o.pvsFar) s->farPlane = *o.pvsFar;
+    std::string err;
+    if (!o.pvsClusters.empty() && !parseClusterList(o.pvsClusters, &s->clusters, &err)) {
+        fail(err);
+        return false;
+    }
+    return true;
+}
+
+// Runs the audit on a loaded scene and writes its three files into `dir`; exit code.
+int runPvsAudit(const Options &o, const Scene &scene, const PvsAuditSettings &settings, const std::string &dir,
+                const std::string &outName, PvsAuditResult *result, nlohmann::ordered_json *json) {
+    if (const char *why = pvsAuditSkipReason(scene)) {
+        fail(scene.path + ": cannot audit the PVS: " + why +
+             (scene.bsp ? "; compile the map with vis (q3map2 -vis)" : "; give a Quake 3 map (.bsp or pak.pk3:maps/x.bsp)"));
+        return kExitBadInput;
+    }
+    PvsAuditSettings s = settings;
+    const bool tty = isatty(fileno(stderr)) && !o.quiet;
+    std::mutex printMutex;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (tty)
+        s.progress = [&](size_t done, size_t total) {
+            if (done % 16 != 0 && done != total) return;
+            std::lock_guard<std::mutex> lock(printMutex);
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            std::fprintf(stderr, "\r\033[K[%zu/%zu clusters] %.1f s, about %.0f s left", done, total, elapsed,
+                         elapsed / double(done) * double(total - done));
+        };
+    std::string err;
+    const bool ok = auditPvs(scene, s, result, &err);
+    if (tty) std::fprintf(stderr, "\n");
+    if (!ok) {
+        if (interrupted()) return interruptedExit(outName);
+        fail(err);
+        return kExitBadInput;
+    }
+    if (!writePvsAudit(*result, dir, json, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    return kExitOk;
+}
+
+int cmdPvsAudit(const Options &o) {
+    installInterruptHandlers();
+    PvsAuditSettings settings;
+    if (!pvsSettings(o, &settings)) return kExitBadInput;
+    Scene scene;
+    LoadOptions lo;
+    lo.bsp.patchLevel = o.patchLevel;
+    lo.maxTriangles = o.maxTriangles;
+    std::string err;
+    if (!loadScene(o.scene, lo, &scene, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (interrupted()) return interruptedExit(o.pvsOut);
+    if (const char *why = pvsAuditSkipReason(scene)) {
+        fail(scene.path + ": cannot audit the PVS: " + why +
+             (scene.bsp ? "; compile the map with vis (q3map2 -vis)" : "; give a Quake 3 map (.bsp or pak.pk3:maps/x.bsp)"));
+        return kExitBadInput;
+    }
+    OutputDir out;
+    if (!out.open(o.pvsOut, &err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    setImageThreads(o.threads);
+    PvsAuditResult result;
+    nlohmann::ordered_json json;
+    const int code = runPvsAudit(o, scene, settings, out.staging(), o.pvsOut, &result, &json);
+    if (code != kExitOk) return code;
+    if (interrupted()) return interruptedExit(o.pvsOut);
+    if (!out.commit(&err)) {
+        fail(err);
+        return kExitBadInput;
+    }
+    if (!err.empty()) std::fprintf(stderr, "visaudit: warning: %s\n", err.c_str());
+    if (o.json) {
+        nlohmann::ordered_json summary;
+        summary["report"] = o.pvsOut + "/pvs-audit.json";
+        summary["map"] = json["map"];
+        summary["far_plane"] = json["far_plane"];
+        summary["totals"] = json["totals"];
+        std::printf("%s\n", summary.dump(2).c_str());
+    } else if (!o.quiet) {
+        std::printf("%sreport: %s/pvs-audit.json, %s/pvs-audit.html\n", pvsAuditTable(result).c_str(), o.pvsOut.c_str(),
+                    o.pvsOut.c_str());
+    }
+    return kExitOk;
+}
+
+void addPvsAuditOptions(CLI::App *c, Options &o) {
+    c->add_option("map", o.scene, "Quake 3 map: x.bsp or pak.pk3:maps/x.bsp")->required();
+    c->add_option("--out", o.pvsOut, "Output folder for pvs-audit.json, .png and .html (written as a whole or not at all)");
+    c->add_option("--samples", o.pvs.samples, "Eye points per cluster (default 32; time grows linearly)")
+        ->check(CLI::Range(1, 1024));
+    c->add_option("--resolution", o.pvs.resolution,
+                  "Cube-face side: 6 x R^2 rays per eye point (default 12: 864 rays; time grows with R^2)")
+        ->check(CLI::Range(1, 256));
+    c->add_option("--seed", o.pvs.seed, "Seed of the eye points and ray rotations (default 1)");
+    c->add_option_function<double>("--far-plane", [&o](double d) { o.pvsFar = d; },
+                                   "Far plane distance (default: the map's _farplanedist; 0 = unlimited)")
+        ->check(CLI::Range(0.0, 1e30));
+    c->add_option("--clusters", o.pvsClusters, "Audit only these clusters, e.g. 0-99,200 (default: every cluster)");
+    c->add_option("--image-size", o.pvs.imageSize, "Longest side of pvs-audit.png in pixels (default 1024; 0 = no image)")
+        ->check(CLI::Range(0, 4096));
+    c->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
+    c->add_option("--patch-level", o.patchLevel, "Segments per Bezier patch edge (patches occlude)")->check(CLI::Range(1, 64));
+    c->add_option("--max-triangles", o.maxTriangles, "Largest map accepted, in triangles")
+        ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
+    c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
+    c->add_flag("--json", o.json, "Print the totals as JSON on stdout");
+}
+
 int cmdCheck(const Options &o) {
     Budget budget;
     nlohmann::ordered_json baseline;
@@ -423,13 +594,40 @@ int cmdCheck(const Options &o) {
         for (const ViewSpec &v : views) names.push_back(v.name);
         return loadBudget(o.budget, names, &budget, e);
     };
+    // A budget naming pvs_* runs the PVS audit on the map too; its files go next to report.json.
+    nlohmann::ordered_json pvsAudit;
+    auto pvs = [&](const Scene &scene, const std::string &staging) {
+        if (!budgetNeedsPvsAudit(budget)) return int(kExitOk);
+        if (const char *why = pvsAuditSkipReason(scene)) {
+            fail("--budget " + o.budget + " names a pvs_* metric, which needs the PVS audit: " + scene.path + ": " + why +
+                 "; check a Quake 3 map, or leave pvs_* out of the budget");
+            return int(kExitBadInput);
+        }
+        PvsAuditSettings s;
+        if (!pvsSettings(o, &s)) return int(kExitBadInput);
+        PvsAuditResult r;
+        return runPvsAudit(o, scene, s, staging, o.out, &r, &pvsAudit);
+    };
     nlohmann::ordered_json report;
-    const int code = analyzeToReport(o, validate, &report);
+    const int code = analyzeToReport(o, validate, &report, pvs);
     if (code != kExitOk) return code;
     BudgetResult result;
     if (!evaluateBudget(budget, report, o.baseline.empty() ? nullptr : &baseline, &result, &err)) {
         fail(err);
         return kExitBadInput;
+    }
+    if (budgetNeedsPvsAudit(budget)) {
+        // The baseline's audit: pvs-audit.json next to the baseline's report.json (absent: no baseline).
+        nlohmann::ordered_json basePvs;
+        bool haveBase = false;
+        if (!o.baseline.empty()) {
+            const std::string p = (std::filesystem::path(o.baseline).parent_path() / "pvs-audit.json").string();
+            haveBase = readJsonDocument(p, &basePvs, nullptr) == JsonRead::ok;
+        }
+        if (!evaluatePvsBudget(budget, pvsAudit, haveBase ? &basePvs : nullptr, &result, &err)) {
+            fail(err);
+            return kExitBadInput;
+        }
     }
     std::printf("%s", budgetTable(result).c_str());
     if (!o.junit.empty() && !writeFileAtomic(o.junit, budgetJUnit(result, report["scene"]["path"]), &err)) {
@@ -725,6 +923,9 @@ const Command kCommands[] = {
     {"merge", "Join the reports of analyze --shard K/N runs into one report", addMergeOptions, cmdMerge},
     {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
      addDepthAuditOptions, cmdDepthAudit},
+    {"pvs-audit", "Audit every cluster of a Quake 3 map's PVS: clusters seen yet hidden (misses), visible yet never seen "
+                  "(slack)",
+     addPvsAuditOptions, cmdPvsAudit},
 };
 
 // Levenshtein distance, for "did you mean" suggestions.

@@ -469,6 +469,59 @@ LocalHit RayScene::intersect(const LocalRay &ray) const {
     return h;
 }
 
+namespace {
+// intersectStream's back-face rejection: a candidate whose geometric normal does not face the ray
+// (dot(Ng, dir) >= 0) is rejected, so the ray continues to what lies behind.
+void streamBackFaceFilter(const RTCFilterFunctionNArguments *args) {
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const float d = RTCHitN_Ng_x(args->hit, args->N, i) * RTCRayN_dir_x(args->ray, args->N, i) +
+                        RTCHitN_Ng_y(args->hit, args->N, i) * RTCRayN_dir_y(args->ray, args->N, i) +
+                        RTCHitN_Ng_z(args->hit, args->N, i) * RTCRayN_dir_z(args->ray, args->N, i);
+        if (d >= 0) args->valid[i] = 0;
+    }
+}
+}  // namespace
+
+void RayScene::intersectStream(const LocalRay *rays, size_t n, bool rejectBackFaces, LocalHit *hits) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    if (rejectBackFaces) ctx.filter = streamBackFaceFilter;
+    alignas(64) RTCRayHit16 rh;
+    alignas(64) int valid[16];
+    for (size_t first = 0; first < n; first += 16) {
+        const size_t count = std::min<size_t>(16, n - first);
+        for (size_t i = 0; i < 16; ++i) {
+            // Lanes past the end repeat the last ray, masked invalid.
+            const LocalRay &r = rays[first + std::min(i, count - 1)];
+            valid[i] = i < count ? -1 : 0;
+            rh.ray.org_x[i] = r.org[0], rh.ray.org_y[i] = r.org[1], rh.ray.org_z[i] = r.org[2];
+            rh.ray.dir_x[i] = r.dir[0], rh.ray.dir_y[i] = r.dir[1], rh.ray.dir_z[i] = r.dir[2];
+            rh.ray.tnear[i] = r.tnear;
+            rh.ray.tfar[i] = r.tfar;
+            rh.ray.time[i] = 0;
+            rh.ray.mask[i] = 0xFFFFFFFFu;
+            rh.ray.id[i] = unsigned(i);
+            rh.ray.flags[i] = 0;
+            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, impl_->scene, &ctx, &rh);
+        for (size_t i = 0; i < count; ++i) {
+            LocalHit &h = hits[first + i];
+            h = LocalHit{};
+            if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+            h.prim = rh.hit.primID[i];
+            h.t = rh.ray.tfar[i];
+            h.u = rh.hit.u[i];
+            h.v = rh.hit.v[i];
+            h.ng[0] = rh.hit.Ng_x[i], h.ng[1] = rh.hit.Ng_y[i], h.ng[2] = rh.hit.Ng_z[i];
+        }
+    }
+}
+
 bool RayScene::occluded(const LocalRay &ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

@@ -108,6 +108,12 @@ class RayScene {
 
     // Closest hit / any hit along one ray (rtcIntersect1 / rtcOccluded1). Thread-safe.
     LocalHit intersect(const LocalRay &ray) const;
+    // Closest hits of n rays of any directions (a ray stream: the PVS audit's rays from one eye),
+    // traced in order as 16-wide packets (rtcIntersect16) on the calling thread; hits[i] is ray
+    // i's, as intersect() would give it (barycentrics and normal included). With rejectBackFaces a
+    // hit on a triangle's back, dot(Ng, dir) >= 0 in float (edge-on counts as back), is passed
+    // through and the ray goes on. Thread-safe; the same rays in the same order give the same hits.
+    void intersectStream(const LocalRay *rays, size_t n, bool rejectBackFaces, LocalHit *hits) const;
     bool occluded(const LocalRay &ray) const;
 
     Vec3 origin() const;

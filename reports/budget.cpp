@@ -22,6 +22,9 @@ const std::vector<BudgetMetric> &budgetMetrics() {
         {"false_culls", "triangles culled by a stage yet visible in the reference (default limit 0)", false, true},
         {"wasted_draw_share", "share of drawn triangles visible nowhere (0..1)", false, true},
         {"min_depth_format", "the cheapest depth format the view must not z-fight in", true, false},
+        // Map-wide, from `visaudit pvs-audit` (docs/pvs-audit.md): check runs the audit when one is named.
+        {"pvs_misses", "cluster pairs a player's eye sees although the map's PVS hides them", false, true, true},
+        {"pvs_slack_share", "share of PVS-visible cluster pairs no eye point sees (0..1)", false, true, true},
     };
     return m;
 }
@@ -50,9 +53,10 @@ std::string fmt(double v) {
     return b;
 }
 
-// Validates one "metric: limit" object at path p.
+// Validates one "metric: limit" object at path p (perView: a view's own limits, where map-wide
+// metrics have no place).
 bool readLimits(const json::Doc &doc, const json::Path &p, const json::Json &obj,
-                std::map<std::string, nlohmann::json> *out, std::string *err) {
+                std::map<std::string, nlohmann::json> *out, std::string *err, bool perView = false) {
     if (!obj.is_object()) {
         *err = json::where(doc, p) + ": " + json::pathString(p) + ": expected an object of limits, got " +
                json::typeName(obj);
@@ -65,6 +69,11 @@ bool readLimits(const json::Doc &doc, const json::Path &p, const json::Json &obj
             *err = json::where(doc, p / key, true) + ": " + json::pathString(p) + ": unknown metric '" + key + "'" +
                    (near.empty() ? "" : ", did you mean '" + near + "'?") +
                    " (known: " + json::joinList(metricNames(false)) + ")";
+            return false;
+        }
+        if (perView && m->mapWide) {
+            *err = json::where(doc, p / key, true) + ": " + json::pathString(p) + ": '" + key +
+                   "' is one number for the whole map (the PVS audit), not per view; put it under \"limits\"";
             return false;
         }
         if (m->isFormat) {
@@ -157,7 +166,7 @@ bool loadBudget(const std::string &path, const std::vector<std::string> &viewNam
                            " (views: " + json::joinList(viewNames) + ")";
                     return false;
                 }
-                if (!readLimits(doc, top / "views" / view, limits, &b.views[view], err)) return false;
+                if (!readLimits(doc, top / "views" / view, limits, &b.views[view], err, true)) return false;
             }
         } else if (key == "regressions") {
             if (!value.is_object()) {
@@ -220,7 +229,7 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
 
         for (const BudgetMetric &m : budgetMetrics()) {
             auto lim = limits.find(m.name);
-            if (lim == limits.end()) continue;
+            if (lim == limits.end() || m.mapWide) continue;
             BudgetCheck c;
             c.view = name;
             c.metric = m.name;
@@ -266,6 +275,7 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
         for (const OJson &bv : (*baseline)["views"])
             if (bv["name"] == name) old = &bv;
         for (const auto &[metric, rise] : budget.regressions) {
+            if (findMetric(metric)->mapWide) continue;
             BudgetCheck c;
             c.view = name;
             c.metric = metric;
@@ -299,6 +309,77 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
     }
     for (const BudgetCheck &c : r.checks) r.failed += !c.pass;
     *out = std::move(r);
+    return true;
+}
+
+bool budgetNeedsPvsAudit(const Budget &budget) {
+    for (const BudgetMetric &m : budgetMetrics())
+        if (m.mapWide && (budget.limits.count(m.name) || budget.regressions.count(m.name))) return true;
+    return false;
+}
+
+namespace {
+// A map-wide metric's value in a pvs-audit.json: totals.misses or totals.slack_share.
+std::optional<double> pvsMetricValue(const std::string &metric, const OJson &audit) {
+    const char *key = metric == "pvs_misses" ? "misses" : "slack_share";
+    if (!audit.is_object() || !audit.contains("totals") || !audit["totals"].is_object() ||
+        !audit["totals"].contains(key) || !audit["totals"][key].is_number())
+        return std::nullopt;
+    return audit["totals"][key].get<double>();
+}
+}  // namespace
+
+bool evaluatePvsBudget(const Budget &budget, const OJson &audit, const OJson *baseline, BudgetResult *out,
+                       std::string *err) {
+    for (const BudgetMetric &m : budgetMetrics()) {
+        if (!m.mapWide) continue;
+        const std::optional<double> v = pvsMetricValue(m.name, audit);
+        const bool limited = budget.limits.count(m.name) > 0, regressed = budget.regressions.count(m.name) > 0;
+        if ((limited || regressed) && !v) {
+            *err = budget.file + ": '" + m.name + "' needs the PVS audit's totals, which pvs-audit.json does not have";
+            return false;
+        }
+        if (limited) {
+            BudgetCheck c;
+            c.view = "(map)";
+            c.metric = m.name;
+            c.kind = "limit";
+            const double limit = budget.limits.at(m.name).get<double>();
+            c.value = fmt(*v);
+            c.allowed = "<= " + fmt(limit);
+            c.pass = *v <= limit;
+            if (!c.pass)
+                c.message = std::string(m.name) + " of the map is " + fmt(*v) + ", allowed " + fmt(limit) + " (" +
+                            m.meaning + "; pvs-audit.html lists the evidence)";
+            out->checks.push_back(c);
+        }
+        if (regressed) {
+            const double rise = budget.regressions.at(m.name);
+            BudgetCheck c;
+            c.view = "(map)";
+            c.metric = m.name;
+            c.kind = "regression";
+            c.allowed = "+" + fmt(rise * 100) + "%";
+            const std::optional<double> before = baseline ? pvsMetricValue(m.name, *baseline) : std::nullopt;
+            if (!before) {
+                c.value = fmt(*v) + " (no baseline)";
+            } else {
+                const double rel = *before > 0 ? (*v - *before) / *before : (*v > 0 ? INFINITY : 0);
+                c.value = fmt(*before) + " -> " + fmt(*v);
+                c.pass = rel <= rise;
+                if (!c.pass) {
+                    char pct[32];
+                    std::snprintf(pct, sizeof pct, "%.0f%%", rel * 100);
+                    c.message = std::string(m.name) + " of the map rose " +
+                                (std::isfinite(rel) ? std::string(pct) : "from 0 to " + fmt(*v)) + ", allowed " +
+                                fmt(rise * 100) + "%";
+                }
+            }
+            out->checks.push_back(c);
+        }
+    }
+    out->failed = 0;
+    for (const BudgetCheck &c : out->checks) out->failed += !c.pass;
     return true;
 }
 

@@ -19,6 +19,8 @@ struct BudgetMetric {
     const char *meaning;     // for messages and the README
     bool isFormat;           // min_depth_format: a depth format name, not a number
     bool higherIsWorse;      // every numeric metric: the limit is a maximum
+    bool mapWide = false;    // one value for the whole map (the PVS audit's pvs_*), not per view: allowed
+                             //   under "limits" and "regressions" only
 };
 const std::vector<BudgetMetric> &budgetMetrics();
 
@@ -51,6 +53,15 @@ struct BudgetResult {
 // report lacks what a budget needs, or the baseline is of another scene or report format.
 bool evaluateBudget(const Budget &budget, const nlohmann::ordered_json &report,
                     const nlohmann::ordered_json *baseline, BudgetResult *out, std::string *err);
+
+// Whether the budget names a map-wide metric (pvs_*): `check` then runs the PVS audit too.
+bool budgetNeedsPvsAudit(const Budget &budget);
+
+// Checks the map-wide limits (and regressions, with the baseline's pvs-audit.json) against a
+// pvs-audit.json (reports/pvs_audit_report.h), appending one check per metric to *out (view
+// "(map)"). False + message when the audit lacks a value the budget needs.
+bool evaluatePvsBudget(const Budget &budget, const nlohmann::ordered_json &pvsAudit,
+                       const nlohmann::ordered_json *baselinePvsAudit, BudgetResult *out, std::string *err);
 
 // A console table of every check (failures first), and the summary line.
 std::string budgetTable(const BudgetResult &r);

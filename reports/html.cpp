@@ -5,6 +5,7 @@
 //   summary      one row per view, worst first, each linking to its section
 //   planner      the report-level "effects" decisions (when present)
 //   depth audit  depth-audit.png when the folder holds one
+//   PVS audit    a link to pvs-audit.html and its image when the folder holds them (check, pvs_*)
 //   per view     camera line; the six questions of visibility; the stage funnel (SVG) and stage
 //                table; images with legends (click to enlarge); z-fighting hotspots (rows link to
 //                boxes over the z-fight image); false culls; ray-cast cross-check; depth formats
@@ -908,6 +909,7 @@ struct HtmlWriter {
     void summary(const std::vector<ViewScore> &worstFirst);
     void planner();
     void depthAuditImage();
+    void pvsAuditLink();
     void view(const Json *v, size_t pos);
     // eager: load with the page (the first views); else lazily, when scrolled near (reports of
     // hundreds of views would otherwise load thousands of PNGs at once).
@@ -1038,6 +1040,22 @@ void HtmlWriter::depthAuditImage() {
     if (auto s = folder.png(name)) o += " width=\"" + std::to_string(s->first) + "\" height=\"" + std::to_string(s->second) + "\"";
     o += "></a><figcaption>Resolution (m) against view depth (m) per depth format, log-log, from "
          "<code>visaudit depth-audit</code>.</figcaption></figure></section>";
+}
+
+// check writes the PVS audit (pvs-audit.html, .png) next to report.json when its budget names a
+// pvs_* metric: its map image and a link to its page.
+void HtmlWriter::pvsAuditLink() {
+    if (!folder.exists("pvs-audit.html")) return;
+    o += "<section class=\"block\" id=\"pvs-audit\"><h2>PVS audit of every cluster</h2><p><a href=\"" +
+         urlOf("pvs-audit.html") + "\">pvs-audit.html</a>: misses, slack and their evidence per cluster.</p>";
+    const std::string name = "pvs-audit.png";
+    if (folder.exists(name)) {
+        o += "<figure id=\"pvs-audit-img\"><a class=\"enlarge imgwrap\" href=\"" + urlOf(name) +
+             "\" data-title=\"pvs-audit.png\"><img src=\"" + urlOf(name) + "\" alt=\"the level from above, colored by slack and misses\"";
+        if (auto sz = folder.png(name)) o += " width=\"" + std::to_string(sz->first) + "\" height=\"" + std::to_string(sz->second) + "\"";
+        o += "></a><figcaption>The level from above, each floor colored by its cluster's misses and slack.</figcaption></figure>";
+    }
+    o += "</section>";
 }
 
 void HtmlWriter::stageTable(const Json *v) {
@@ -1455,6 +1473,7 @@ std::string reportHtml(const nlohmann::ordered_json &report, const std::string &
         o += "<section class=\"block\" id=\"scene\"><h2>Scene</h2><details><summary>as loaded</summary>" + genericJson(scene) +
              "</details></section>\n";
     w.depthAuditImage();
+    w.pvsAuditLink();
     for (size_t i = 0; i < vs.size(); ++i) {
         w.view(vs[i], i);
         o += "\n";
@@ -1467,5 +1486,7 @@ std::string reportHtml(const nlohmann::ordered_json &report, const std::string &
 bool writeReportHtml(const nlohmann::ordered_json &report, const std::string &dir, std::string *err) {
     return writeFileAtomic(dir + "/report.html", reportHtml(report, dir), err);
 }
+
+std::string htmlEscape(std::string_view text) { return esc(text); }
 
 }  // namespace va

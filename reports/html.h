@@ -11,6 +11,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -26,5 +27,9 @@ std::string reportHtml(const nlohmann::ordered_json &report, const std::string &
 // are in `dir` (the OutputDir staging folder), before commit(). False + *err naming the path on
 // failure; a report of an unexpected shape never fails (missing parts are left out of the page).
 bool writeReportHtml(const nlohmann::ordered_json &report, const std::string &dir, std::string *err);
+
+// Text made safe for HTML content and quoted attributes (report.html's own escaping: markup
+// characters as entities, control characters and invalid UTF-8 as U+FFFD); other pages use it.
+std::string htmlEscape(std::string_view text);
 
 }  // namespace va

@@ -39,7 +39,8 @@ bool isDirectory(const std::string &p) {
 }
 
 // Whether an existing folder may be replaced: empty, or a visaudit report folder (holds a regular
-// file report.json). Anything else is someone's data and is never touched.
+// file report.json, or pvs-audit.json: a pvs-audit folder). Anything else is someone's data and is
+// never touched.
 bool replaceable(const std::string &dir, std::string *why) {
     std::error_code ec;
     fs::directory_iterator it(dir, ec);
@@ -49,6 +50,7 @@ bool replaceable(const std::string &dir, std::string *why) {
     }
     if (it == fs::directory_iterator()) return true;
     if (fs::is_regular_file(fs::path(dir) / "report.json", ec)) return true;
+    if (fs::is_regular_file(fs::path(dir) / "pvs-audit.json", ec)) return true;
     *why = "refusing to replace '" + dir +
            "': it is not empty and holds no report.json, so it is not a visaudit report folder; "
            "choose another --out folder (or an empty one)";
