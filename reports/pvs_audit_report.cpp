@@ -315,7 +315,7 @@ bool pvsAuditImage(const PvsAuditResult &r, std::vector<uint8_t> *out, int *widt
             if (std::isfinite(z)) {
                 const double hf = zHi > zLo ? (z - zLo) / (zHi - zLo) : 1.0;
                 double shade = 0.35 + 0.4 * hf + 0.25 * v.slope[p];
-                for (const auto [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+                for (const auto &[dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
                     const int nx = x + dx, ny = y + dy;
                     if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
                     const float n = heightAt(nx, ny);
