@@ -28,8 +28,11 @@ struct ReferenceSink {
     uint32_t *id;
     double *depth;
     uint8_t *snappedFront;
+    FragmentCache *cache;  // null: not recorded
+    uint64_t cacheMax = 0;
     uint32_t current = 0;  // 1 + source of the triangle being walked
     uint64_t backWinding = 0, fragments = 0;
+    bool overflow = false;
 
     bool beginTriangle(size_t t, bool frontWinding) {
         const uint32_t s = source[t];
@@ -56,13 +59,24 @@ struct ReferenceSink {
         return -area <= std::abs(e1x) + std::abs(e1y) + std::abs(e2x) + std::abs(e2y) + 4;
     }
     void fragment(size_t i, size_t, double d) {
+        if (cache && !overflow) {
+            if (cache->pixel.size() == cacheMax) {
+                overflow = true;
+            } else {
+                cache->pixel.push_back(uint32_t(i));
+                cache->depth.push_back(d);
+            }
+        }
         const double old = depth[i];
         if (d < old || (d == old && current < id[i])) {
             depth[i] = d;
             id[i] = current;
         }
     }
-    void endTriangle(size_t, uint64_t n) { fragments += n; }
+    void endTriangle(size_t t, uint64_t n) {
+        fragments += n;
+        if (cache) cache->begin[t + 1] = cache->pixel.size();
+    }
 };
 
 // Unit roundoff of float (Embree's arithmetic) and pbrt's gamma(n) = n u / (1 - n u): a bound on
@@ -121,7 +135,7 @@ std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
     return s;
 }
 
-ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
+ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments) {
     const Stopwatch t0;
     ReferenceVisibility r;
     r.width = std::max(cam.width, 0);
@@ -136,17 +150,33 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam) {
         batches.push_back({o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
         r.trianglesIn += o.triEnd - o.triBegin;
     }
-    const ClipResult clip =
-        clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{});
-    r.screenTriangles = clip.out.size();
+    r.screen = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    const ScreenTriangles &screen = r.screen;
+    r.screenTriangles = screen.size();
 
     r.id.assign(pixels, 0);
     r.depth.assign(pixels, std::numeric_limits<double>::infinity());
     const std::vector<uint8_t> single = singleSidedTriangles(scene);
     r.snappedFront.assign(scene.triangleCount(), 0);
-    ReferenceSink sink{scene,         cam,         clip.out.xy.data(), clip.out.source.data(), single.data(),
-                       r.id.data(),   r.depth.data(), r.snappedFront.data()};
-    forEachFragment(clip.out, r.width, r.height, cam.orthographic, sink);
+    FragmentCache &cache = r.fragmentCache;
+    if (maxCachedFragments) {
+        cache.begin.assign(screen.size() + 1, 0);
+        // Reserved whole, so it never reallocates (pages are touched only as fragments arrive).
+        cache.pixel.reserve(maxCachedFragments);
+        cache.depth.reserve(maxCachedFragments);
+    }
+    const Stopwatch tr;
+    ReferenceSink sink{scene,        cam,           screen.xy.data(),       screen.source.data(),
+                       single.data(), r.id.data(),  r.depth.data(),         r.snappedFront.data(),
+                       maxCachedFragments ? &cache : nullptr, maxCachedFragments};
+    forEachFragment(screen, r.width, r.height, cam.orthographic, sink);
+    if (sink.overflow) {
+        cache = FragmentCache{};
+    } else if (maxCachedFragments) {
+        // Triangles the walk skipped (no endTriangle) hold no fragment: begin[t + 1] = begin[t].
+        for (size_t t = 0; t < screen.size(); ++t) cache.begin[t + 1] = std::max(cache.begin[t + 1], cache.begin[t]);
+        cache.rasterMs = tr.ms();
+    }
     r.backWinding = sink.backWinding;
     r.fragments = sink.fragments;
     for (uint8_t f : r.snappedFront) r.snappedFrontTriangles += f;

@@ -28,6 +28,19 @@ std::vector<uint8_t> singleSidedTriangles(const Scene &scene);
 // not matter). Single-sided triangles are seen from their front only -- that is what the material
 // means, not a culling decision -- and the front is decided by the projected winding on screen, as
 // hardware does, independently of the backface stage's plane test: so that stage is really audited.
+// Every fragment of one rasterization of a view's screen triangles, kept for the passes that walk
+// the same fragments again in another order (the ordering audit: painter's, BSP, overdraw by
+// order). Per screen triangle t its fragments are [begin[t], begin[t + 1]) of `pixel` and `depth`,
+// exactly those forEachFragment gave the drawing sink (single-sided triangles with the back winding
+// have none), each with its view depth d bit-identical to the walk's.
+struct FragmentCache {
+    std::vector<uint64_t> begin;    // per screen triangle, + 1 entry
+    std::vector<uint32_t> pixel;    // y * width + x
+    std::vector<double> depth;
+    double rasterMs = 0;            // the rasterization that recorded them (walk + record)
+    bool complete() const { return !begin.empty(); }
+};
+
 struct ReferenceVisibility {
     int width = 0, height = 0;
     std::vector<uint32_t> id;         // per pixel: 1 + visible source triangle, 0 = background
@@ -46,8 +59,12 @@ struct ReferenceVisibility {
     std::vector<uint8_t> snappedFront;
     uint64_t snappedFrontTriangles = 0;
     double ms = 0;                    // wall time (clip + rasterize + counts)
+    ScreenTriangles screen;           // the clip's output (every object's batch, submission order)
+    FragmentCache fragmentCache;      // when asked for and within its bound (else empty)
 };
-ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam);
+// `maxCachedFragments` > 0 keeps every fragment in `fragments` as long as there are at most that
+// many (12 bytes each); more, and fragmentCache stays empty (its users rasterize again: same results).
+ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments = 0);
 
 // ---- False culls and wasted draws ---------------------------------------------------------------
 

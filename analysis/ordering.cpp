@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <unordered_map>
 
 #include "render/clip.h"
 #include "render/raster_core.h"
@@ -27,9 +28,39 @@ int64_t screenArea(const ScreenTriangles &st, size_t t) {
     return (int64_t(p[2]) - p[0]) * (int64_t(p[5]) - p[1]) - (int64_t(p[3]) - p[1]) * (int64_t(p[4]) - p[0]);
 }
 
+// The surface point at pixel (x, y)'s center at view depth d, origin + direction * d of
+// viewRayThroughPixel(x + 0.5, y + 0.5) component by component (the same IEEE operations, so the
+// same bits), with the ray's x parts per column and y parts per row computed once per view
+// instead of two divisions per fragment.
+struct PixelRays {
+    std::vector<double> ox, dx, oy, dy;
+    double oz = 0, dz = 0;
+    size_t width = 0;
+
+    explicit PixelRays(const Camera &cam) {
+        const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
+        width = size_t(W);
+        ox.resize(size_t(W)), dx.resize(size_t(W)), oy.resize(size_t(H)), dy.resize(size_t(H));
+        for (int x = 0; x < W; ++x) {
+            const ViewRay r = viewRayThroughPixel(cam, double(x) + 0.5, 0.5);
+            ox[size_t(x)] = r.origin.x, dx[size_t(x)] = r.direction.x;
+            oz = r.origin.z, dz = r.direction.z;
+        }
+        for (int y = 0; y < H; ++y) {
+            const ViewRay r = viewRayThroughPixel(cam, 0.5, double(y) + 0.5);
+            oy[size_t(y)] = r.origin.y, dy[size_t(y)] = r.direction.y;
+        }
+    }
+    Vec3 point(size_t pixel, double d) const {
+        const size_t x = pixel % width, y = pixel / width;
+        return {ox[x] + dx[x] * d, oy[y] + dy[y] * d, oz + dz * d};
+    }
+};
+
 // The drawing sink: optional depth test (LESS on the double depth), optional piece filter.
 struct OrderSink {
     const OrderingView &v;
+    const PixelRays &rays;
     const std::vector<uint32_t> &itemOf;  // per screen triangle of the draw list: its item
     const std::vector<DrawItem> &items;
     const BspTree *tree;
@@ -49,12 +80,8 @@ struct OrderSink {
         return true;
     }
     void fragment(size_t i, size_t, double d) {
-        if (piece != UINT32_MAX) {
-            // The surface point at the pixel center: on the ray through it at view depth d.
-            const size_t x = i % size_t(v.cam.width), y = i / size_t(v.cam.width);
-            const ViewRay r = viewRayThroughPixel(v.cam, double(x) + 0.5, double(y) + 0.5);
-            if (!bspPieceContains(*tree, *planes, piece, r.origin + r.direction * d)) return;
-        }
+        // The surface point at the pixel center: on the ray through it at view depth d.
+        if (piece != UINT32_MAX && !bspPieceContains(*tree, *planes, piece, rays.point(i, d))) return;
         ++fragments;
         if (!depthTest) {
             id[i] = current;
@@ -70,16 +97,22 @@ struct OrderSink {
 
 }  // namespace
 
-OrderingView prepareOrderingView(const Scene &scene, const Camera &cam) {
-    const Stopwatch t0;
+OrderingView prepareOrderingView(const Scene &scene, const Camera &cam, const ReferenceVisibility *ref) {
     OrderingView v;
     v.scene = &scene;
     v.cam = cam;
-    std::vector<ClipBatch> batches;
-    for (const SceneObject &o : scene.objects)
-        if (o.triEnd > o.triBegin)
-            batches.push_back({o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
-    v.all = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    if (ref) {
+        // The reference clipped the same batches with the same settings (referenceVisibility).
+        v.all = ref->screen;
+        if (ref->fragmentCache.complete()) v.fragments = &ref->fragmentCache;
+    } else {
+        std::vector<ClipBatch> batches;
+        for (const SceneObject &o : scene.objects)
+            if (o.triEnd > o.triBegin)
+                batches.push_back(
+                    {o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
+        v.all = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    }
     v.screenBegin.assign(scene.triangleCount(), 0);
     v.screenEnd.assign(scene.triangleCount(), 0);
     // The clipper emits a source's fan pieces consecutively.
@@ -89,7 +122,6 @@ OrderingView prepareOrderingView(const Scene &scene, const Camera &cam) {
         v.screenEnd[s] = uint32_t(t + 1);
     }
     v.singleSided = singleSidedTriangles(scene);
-    v.clipMs = t0.ms();
     return v;
 }
 
@@ -152,9 +184,179 @@ std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
     return order;
 }
 
+namespace {
+
+// Per drawn item, the indices of its fragments in the view's fragment cache: a whole triangle's
+// are its screen triangles' ranges; a BSP piece's, those of its source whose surface point the
+// piece contains (the test the uncached sink makes per fragment, on the same values).
+struct ItemFragments {
+    std::vector<uint64_t> begin;  // per item, + 1 entry
+    std::vector<uint32_t> index;
+};
+
+// A split source's pieces test their fragments against the same few node planes (the splits that
+// cut the source): each fragment's side of each of those planes is evaluated once, as a bit (the
+// expression of bspPieceContains, so the same bits), and a piece takes the fragments whose bits
+// match its constraints -- instead of every piece evaluating its planes for every fragment of the
+// source (pieces x constraints plane tests per fragment). Up to 64 distinct planes per source;
+// more, and the source's pieces test their fragments directly.
+struct SourceSides {
+    std::vector<uint32_t> nodes;  // the distinct constraint nodes of the source's pieces
+    uint64_t first = 0;           // its fragments' bits: SplitSides::bits[first, first + count)
+    bool direct = false;          // more than 64 nodes
+};
+
+ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, const BspTree *tree,
+                              const BspViewPlanes *planes) {
+    const FragmentCache &fc = *v.fragments;
+    const PixelRays rays(v.cam);
+    auto fragmentsOf = [&](uint32_t s) { return std::pair{fc.begin[v.screenBegin[s]], fc.begin[v.screenEnd[s]]}; };
+    auto constrained = [&](const DrawItem &it) { return it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount; };
+
+    // Per split source: its nodes, then its fragments' side bits.
+    std::unordered_map<uint32_t, SourceSides> sides;
+    for (const DrawItem &it : items) {
+        if (!constrained(it)) continue;
+        SourceSides &ss = sides[it.source];
+        const BspPiece &p = tree->pieces[it.piece];
+        for (uint32_t i = 0; i < p.constraintCount; ++i) {
+            const uint32_t node = tree->constraints[p.firstConstraint + i].node;
+            if (std::find(ss.nodes.begin(), ss.nodes.end(), node) == ss.nodes.end()) ss.nodes.push_back(node);
+        }
+    }
+    std::vector<uint64_t> bits;
+    for (auto &[s, ss] : sides) {
+        if (ss.nodes.size() > 64) {
+            ss.direct = true;
+            continue;
+        }
+        const auto [f0, f1] = fragmentsOf(s);
+        ss.first = bits.size();
+        for (uint64_t f = f0; f < f1; ++f) {
+            const Vec3 pv = rays.point(fc.pixel[f], fc.depth[f]);
+            uint64_t b = 0;
+            for (size_t j = 0; j < ss.nodes.size(); ++j) {
+                const double *q = &planes->plane[4 * size_t(ss.nodes[j])];
+                const bool front = (q[0] * pv.x + q[1] * pv.y + q[2] * pv.z) + q[3] >= 0;
+                b |= uint64_t(front) << j;
+            }
+            bits.push_back(b);
+        }
+    }
+
+    ItemFragments sel;
+    sel.begin.assign(items.size() + 1, 0);
+    for (size_t k = 0; k < items.size(); ++k) {
+        const DrawItem &it = items[k];
+        const auto [f0, f1] = fragmentsOf(it.source);
+        if (!constrained(it)) {
+            for (uint64_t f = f0; f < f1; ++f) sel.index.push_back(uint32_t(f));
+        } else if (const SourceSides &ss = sides.at(it.source); ss.direct) {
+            for (uint64_t f = f0; f < f1; ++f)
+                if (bspPieceContains(*tree, *planes, it.piece, rays.point(fc.pixel[f], fc.depth[f])))
+                    sel.index.push_back(uint32_t(f));
+        } else {
+            // The piece's constraints as a mask of the source's nodes and the sides it wants.
+            uint64_t mask = 0, want = 0;
+            bool never = false;  // two constraints on one node wanting both sides: nothing matches
+            const BspPiece &p = tree->pieces[it.piece];
+            for (uint32_t i = 0; i < p.constraintCount; ++i) {
+                const BspConstraint &c = tree->constraints[p.firstConstraint + i];
+                const uint64_t bit = uint64_t(1) << (std::find(ss.nodes.begin(), ss.nodes.end(), c.node) - ss.nodes.begin());
+                never = never || ((mask & bit) && ((want & bit) != 0) != c.front);
+                mask |= bit;
+                if (c.front) want |= bit;
+            }
+            const uint64_t *b = bits.data() + ss.first;
+            if (!never)
+                for (uint64_t f = f0; f < f1; ++f)
+                    if ((b[f - f0] & mask) == want) sel.index.push_back(uint32_t(f));
+        }
+        sel.begin[k + 1] = sel.index.size();
+    }
+    return sel;
+}
+
+// The per-pixel results of a draw, and its counts.
+struct DrawTarget {
+    std::vector<double> depth;
+    std::vector<uint32_t> id;
+    uint64_t fragments = 0, passes = 0;
+
+    DrawTarget(size_t pixels, bool depthTest)
+        : depth(depthTest ? pixels : 0, std::numeric_limits<double>::infinity()), id(pixels, 0) {}
+    template <bool kDepthTest>
+    void write(uint32_t pixel, double d, uint32_t current) {
+        ++fragments;
+        if constexpr (!kDepthTest) {
+            id[pixel] = current;
+            ++passes;
+        } else if (d < depth[pixel]) {
+            depth[pixel] = d;
+            id[pixel] = current;
+            ++passes;
+        }
+    }
+    DrawStats finish(std::vector<uint32_t> *idsOut) {
+        DrawStats st;
+        st.fragments = fragments;
+        st.depthPasses = passes;
+        for (uint32_t i : id) st.coveredPixels += i != 0;
+        st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+        st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+        if (idsOut) *idsOut = std::move(id);
+        return st;
+    }
+};
+
+// A draw from the fragment cache: items in order, each one's fragments by `sel` when given, else
+// its source's screen triangles' ranges. The same fragments in the same item order as the
+// rasterizing draw (within a triangle the order is immaterial: no pixel twice), so the same result.
+template <bool kDepthTest>
+DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, const ItemFragments *sel,
+                     std::vector<uint32_t> *idsOut) {
+    const FragmentCache &fc = *v.fragments;
+    DrawTarget target(size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0)), kDepthTest);
+    for (size_t k = 0; k < items.size(); ++k) {
+        const uint32_t current = items[k].source + 1;
+        if (sel) {
+            for (uint64_t j = sel->begin[k]; j < sel->begin[k + 1]; ++j) {
+                const uint32_t f = sel->index[j];
+                target.write<kDepthTest>(fc.pixel[f], fc.depth[f], current);
+            }
+        } else {
+            const uint32_t s = items[k].source;
+            for (uint64_t f = fc.begin[v.screenBegin[s]]; f < fc.begin[v.screenEnd[s]]; ++f)
+                target.write<kDepthTest>(fc.pixel[f], fc.depth[f], current);
+        }
+    }
+    return target.finish(idsOut);
+}
+
+DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
+                     const ItemFragments *sel, std::vector<uint32_t> *idsOut) {
+    return depthTest ? drawCached<true>(v, items, sel, idsOut) : drawCached<false>(v, items, sel, idsOut);
+}
+
+bool hasConstrainedPiece(const std::vector<DrawItem> &items, const BspTree *tree) {
+    for (const DrawItem &it : items)
+        if (it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount) return true;
+    return false;
+}
+
+}  // namespace
+
 DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest, const BspTree *tree,
                       const BspViewPlanes *planes, std::vector<uint32_t> *idsOut) {
     const Stopwatch t0;
+    if (v.fragments) {
+        ItemFragments sel;
+        const bool pieces = hasConstrainedPiece(items, tree);
+        if (pieces) sel = selectFragments(v, items, tree, planes);
+        DrawStats st = drawCached(v, items, depthTest, pieces ? &sel : nullptr, idsOut);
+        st.ms = t0.ms() + v.fragments->rasterMs;
+        return st;
+    }
     DrawStats st;
     // The draw list: each item's screen triangles, in item order (depth planes shared with `all`).
     ScreenTriangles list;
@@ -172,7 +374,8 @@ DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items,
     const size_t pixels = size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0));
     std::vector<double> depth(depthTest ? pixels : 0, std::numeric_limits<double>::infinity());
     std::vector<uint32_t> id(pixels, 0);
-    OrderSink sink{v, itemOf, items, tree, planes, depthTest, depth, id};
+    const PixelRays rays(v.cam);
+    OrderSink sink{v, rays, itemOf, items, tree, planes, depthTest, depth, id};
     forEachFragment(list, v.cam.width, v.cam.height, v.cam.orthographic, sink);
     st.fragments = sink.fragments;
     st.depthPasses = sink.passes;
@@ -372,14 +575,39 @@ BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, 
         if (v.screenEnd[tree.pieces[p].source] > v.screenBegin[tree.pieces[p].source])
             items.push_back({tree.pieces[p].source, p});
     r.piecesDrawn = items.size();
-    r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
+    if (v.fragments) {
+        // Both orders draw the same pieces' fragments: the piece test runs once, and each order's
+        // time is its own pass plus that selection plus the rasterization that recorded them.
+        const Stopwatch ts;
+        ItemFragments sel = selectFragments(v, items, &tree, &planes);
+        const double selectMs = ts.ms() + v.fragments->rasterMs;
+        const Stopwatch tb;
+        r.backToFront = drawCached(v, items, false, &sel, &r.id);
+        r.backToFront.ms = tb.ms() + selectMs;
+        // Front to back is the reverse order: reverse the items and their fragment lists.
+        std::reverse(items.begin(), items.end());
+        ItemFragments rev;
+        rev.begin.resize(sel.begin.size());
+        rev.index.reserve(sel.index.size());
+        for (size_t k = items.size(); k-- > 0;) {
+            rev.begin[items.size() - 1 - k] = rev.index.size();
+            rev.index.insert(rev.index.end(), sel.index.begin() + int64_t(sel.begin[k]),
+                             sel.index.begin() + int64_t(sel.begin[k + 1]));
+        }
+        rev.begin.back() = rev.index.size();
+        const Stopwatch tf;
+        r.frontToBack = drawCached(v, items, true, &rev, nullptr);
+        r.frontToBack.ms = tf.ms() + selectMs;
+    } else {
+        r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
+        std::reverse(items.begin(), items.end());
+        r.frontToBack = drawInOrder(v, items, true, &tree, &planes, nullptr);
+    }
     PixelComparison c = compareWithReference(v, ref, r.id);
     r.wrongPixels = c.wrongPixels;
     r.tiePixels = c.tiePixels;
     r.edgePixels = c.edgePixels;
     r.cls = std::move(c.cls);
-    std::reverse(items.begin(), items.end());
-    r.frontToBack = drawInOrder(v, items, true, &tree, &planes, nullptr);
     return r;
 }
 
@@ -414,7 +642,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
                                const BspTree &tree, const EffectDecision &abuffer, const OrderingSettings &settings) {
     const Stopwatch t0;
     OrderingResult r;
-    const OrderingView v = prepareOrderingView(scene, cam);
+    const OrderingView v = prepareOrderingView(scene, cam, &ref);
     const size_t pixels = size_t(std::max(cam.width, 0)) * size_t(std::max(cam.height, 0));
 
     r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);

@@ -44,9 +44,18 @@ struct OrderingView {
     std::vector<uint32_t> screenBegin;    // per source triangle: its screen triangles are
     std::vector<uint32_t> screenEnd;      //   all[screenBegin, screenEnd) (empty when clipped away)
     std::vector<uint8_t> singleSided;     // per source triangle (singleSidedTriangles)
-    double clipMs = 0;
+    // The reference's fragments of `all` (the same clip, the same drawing rule), when it kept them:
+    // the draws below then walk each triangle's fragments from it instead of rasterizing it again
+    // (same fragments, same depths, so the same results); null: they rasterize.
+    const FragmentCache *fragments = nullptr;
 };
-OrderingView prepareOrderingView(const Scene &scene, const Camera &cam);
+// The pipeline keeps the reference's fragments for the ordering audit up to this many per pixel
+// (a level's depth complexity is a few layers; oa_thor's spawns 1.2-2.5); beyond, it rasterizes again.
+constexpr uint64_t kOrderingCachedFragmentsPerPixel = 4;
+
+// With `ref`, its clip (the same batches and settings) and its fragment cache are reused: the
+// scene is clipped and rasterized once per view for the reference and every ordering method.
+OrderingView prepareOrderingView(const Scene &scene, const Camera &cam, const ReferenceVisibility *ref = nullptr);
 
 // Pixel-by-pixel comparison of a method's visible ids (1 + source, 0 background) with the reference.
 enum : uint8_t { kOrderRight = 0, kOrderWrong = 1, kOrderTie = 2, kOrderEdge = 3 };
@@ -133,7 +142,8 @@ struct DrawStats {
     uint64_t coveredPixels = 0;
     double overdraw = 0;         // depthPasses / coveredPixels; best 1
     double depthComplexity = 0;  // fragments / coveredPixels
-    double ms = 0;
+    double ms = 0;               // the draw; from the fragment cache: its pass plus the one
+                                 //   rasterization that recorded the fragments (what drawing alone costs)
 };
 
 // Draws items in order: with the depth test (LESS on the double view depth: the first drawn of

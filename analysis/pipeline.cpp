@@ -320,7 +320,11 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     if (stopped()) return r;
     if (s.audit) {
         const Stopwatch t0;
-        r.reference = referenceVisibility(scene, cam);
+        // The ordering audit walks the reference's fragments again in other orders: kept for it,
+        // up to 4 per pixel (48 bytes a pixel; estimateMemory), above which it rasterizes again.
+        const uint64_t pixels = uint64_t(std::max(cam.width, 0)) * uint64_t(std::max(cam.height, 0));
+        const uint64_t cache = ps.bspTree ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
+        r.reference = referenceVisibility(scene, cam, cache);
         r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource);
         r.auditMs = t0.ms();
         r.auditRan = true;
@@ -336,6 +340,8 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         os.abufferMaxList = s.limits.maxABufferList;
         r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer, os);
         r.orderingRan = true;
+        r.reference.fragmentCache = FragmentCache{};
+        r.reference.screen = ScreenTriangles{};
     } else {
         r.orderingReason = ps.orderingReason.empty() ? "needs the reference visibility" : ps.orderingReason;
     }
@@ -402,7 +408,7 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     const EffectPlan plan = planEffects(scene, s.effects);
     if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;
     if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) {
-        perPixel += 22;
+        perPixel += 22 + 12 * kOrderingCachedFragmentsPerPixel;  // + the reference's fragment cache
         // The A-buffer's fragments: a level's depth complexity is a few layers; the pool itself is
         // counted before it is allocated (--max-abuffer-list), 20 bytes a fragment.
         if (plan.abuffer.run) perPixel += 36 + 4 * sizeof(ABufferFragment);

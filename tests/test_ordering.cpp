@@ -283,6 +283,32 @@ void checkScene(const Scene &s, const std::vector<ViewSpec> &views, const std::s
         // Back to front is the worst order for a depth test: every fragment nearer than all before.
         EXPECT_GE(r.overdrawByOrder[1].stats.depthPasses, r.overdrawByOrder[2].stats.depthPasses);
         EXPECT_EQ(r.abufferRan, plan.abuffer.run);
+
+        // From the reference's fragment cache (the pipeline's way): the same results as drawing
+        // by rasterizing again (above); with a cache too small to hold the view, it is dropped and
+        // the draws rasterize.
+        const ReferenceVisibility cached = referenceVisibility(s, cam, uint64_t(1) << 30);
+        ASSERT_TRUE(cached.fragmentCache.complete());
+        EXPECT_EQ(cached.fragmentCache.pixel.size(), ref.fragments);
+        EXPECT_FALSE(referenceVisibility(s, cam, ref.fragments - 1).fragmentCache.complete());
+        EXPECT_TRUE(referenceVisibility(s, cam, ref.fragments).fragmentCache.complete());
+        EXPECT_EQ(cached.id, ref.id);
+        const OrderingResult c = analyzeOrdering(s, cam, cached, tree, plan.abuffer);
+        auto same = [&](const DrawStats &a, const DrawStats &b, const std::string &name) {
+            EXPECT_EQ(a.fragments, b.fragments) << name;
+            EXPECT_EQ(a.depthPasses, b.depthPasses) << name;
+            EXPECT_EQ(a.coveredPixels, b.coveredPixels) << name;
+        };
+        EXPECT_EQ(c.painter.id, r.painter.id);
+        EXPECT_EQ(c.painter.fragments, r.painter.fragments);
+        EXPECT_EQ(c.painter.cls, r.painter.cls);
+        EXPECT_EQ(c.bsp.id, r.bsp.id);
+        EXPECT_EQ(c.bsp.cls, r.bsp.cls);
+        same(c.bsp.backToFront, r.bsp.backToFront, "bsp back to front");
+        same(c.bsp.frontToBack, r.bsp.frontToBack, "bsp front to back");
+        ASSERT_EQ(c.overdrawByOrder.size(), r.overdrawByOrder.size());
+        for (size_t k = 0; k < r.overdrawByOrder.size(); ++k)
+            same(c.overdrawByOrder[k].stats, r.overdrawByOrder[k].stats, r.overdrawByOrder[k].order);
     }
 }
 
