@@ -5,6 +5,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -229,6 +230,26 @@ double area2(const BspTree &t, const BspPiece &p) {
 
 }  // namespace
 
+namespace {
+
+// Whether the rounded difference x = fl(h - l) is exact: Knuth's TwoSum error of x + l, which is
+// exact (no overflow at level magnitudes), is 0 and x + l == h (Shewchuk's Two_Diff_Tail).
+bool differenceIsExact(double h, double l, double x) {
+    const double bvirt = h - x, avirt = x + bvirt;
+    const double bround = bvirt - l, around = h - avirt;
+    return around + bround == 0;
+}
+
+// The exponent of the lowest set bit of finite nonzero v's significand: v = m 2^k with m odd.
+int lowestBitExponent(double v) {
+    int k;
+    const double m = std::frexp(v, &k);                   // v = m 2^k, 0.5 <= |m| < 1
+    const uint64_t bits = uint64_t(std::fabs(std::ldexp(m, 53)));  // 53-bit integer significand
+    return k - 53 + std::countr_zero(bits);
+}
+
+}  // namespace
+
 int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     // Static filter first (Shewchuk's orient3d, stage A): with the three rows as rounded
     // differences r1 = b - a, r2 = c - a, r3 = d - a, the double determinant r1 . (r2 x r3) is
@@ -247,6 +268,42 @@ int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     const double bound = (7.0 + 56.0 * eps) * eps * permanent;
     if (det > bound) return 1;
     if (det < -bound) return -1;
+    // Exact zeros the filter cannot see (its bound is 0 or the terms cancel), common in levels:
+    // d equal to a corner, and every term of the expansion holding a factor that is exactly zero
+    // (a difference of doubles is 0 only when they are equal, so the exact difference is 0 too),
+    // as for four points on one axis-aligned plane. Then the exact determinant is 0.
+    if (d == a || d == b || d == c) return 0;
+    const bool z1 = r2y == 0 || r3z == 0, z2 = r2z == 0 || r3y == 0, z3 = r2z == 0 || r3x == 0,
+               z4 = r2x == 0 || r3z == 0, z5 = r2x == 0 || r3y == 0, z6 = r2y == 0 || r3x == 0;
+    if ((r1x == 0 || (z1 && z2)) && (r1y == 0 || (z3 && z4)) && (r1z == 0 || (z5 && z6))) return 0;
+    // Integer stage: when the nine differences are exact and are integer multiples of one power of
+    // two 2^e with quotients below 2^40 in magnitude -- as level coordinates on a grid, or floats of
+    // similar size, are -- the determinant of the quotients is exact in 128-bit integers (products
+    // of three below 2^120, six of them below 2^123), and its sign is the sign sought.
+    {
+        const double r[9] = {r1x, r1y, r1z, r2x, r2y, r2z, r3x, r3y, r3z};
+        const double hi[9] = {b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+        const double lo[3] = {a.x, a.y, a.z};
+        bool exact = true;
+        int e = INT32_MAX;
+        for (int i = 0; i < 9 && exact; ++i) {
+            exact = differenceIsExact(hi[i], lo[i % 3], r[i]);
+            if (r[i] != 0) e = std::min(e, lowestBitExponent(r[i]));
+        }
+        if (exact) {
+            __int128 q[9];
+            for (int i = 0; i < 9 && exact; ++i) {
+                const double v = std::ldexp(r[i], -e);  // an integer: exact (a power-of-two scale)
+                exact = std::fabs(v) < 0x1p40;
+                q[i] = exact ? __int128(int64_t(v)) : 0;
+            }
+            if (exact) {
+                const __int128 det128 = q[0] * (q[4] * q[8] - q[5] * q[7]) + q[1] * (q[5] * q[6] - q[3] * q[8]) +
+                                        q[2] * (q[3] * q[7] - q[4] * q[6]);
+                return det128 > 0 ? 1 : (det128 < 0 ? -1 : 0);
+            }
+        }
+    }
     // CGAL::orientation(p, q, r, s) is the sign of det[q - p, r - p, s - p] (POSITIVE when s is on
     // the side the counter-clockwise normal of (p, q, r) points to; tested in BspTree.Orient3d*).
     const CGAL::Orientation o = CGAL::orientation(P(a), P(b), P(c), P(d));

@@ -7,6 +7,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include <CGAL/box_intersection_d.h>
+
 #include "render/clip.h"
 #include "render/raster_core.h"
 #include "render/stopwatch.h"
@@ -194,16 +196,55 @@ struct ItemFragments {
     std::vector<uint32_t> index;
 };
 
-// A split source's pieces test their fragments against the same few node planes (the splits that
-// cut the source): each fragment's side of each of those planes is evaluated once, as a bit (the
-// expression of bspPieceContains, so the same bits), and a piece takes the fragments whose bits
-// match its constraints -- instead of every piece evaluating its planes for every fragment of the
-// source (pieces x constraints plane tests per fragment). Up to 64 distinct planes per source;
-// more, and the source's pieces test their fragments directly.
-struct SourceSides {
-    std::vector<uint32_t> nodes;  // the distinct constraint nodes of the source's pieces
-    uint64_t first = 0;           // its fragments' bits: SplitSides::bits[first, first + count)
-    bool direct = false;          // more than 64 nodes
+// A split source's pieces partition it by the planes of the splits that cut it, and each piece's
+// constraints run from the first split to the last (buildBspTree appends a split's constraint to
+// its parent piece's). So the pieces of one source are the leaves of a binary trie: the first
+// split's plane at the root, the side of it selecting the subtree. A fragment descends it,
+// evaluating each plane on its path once (the expression of bspPieceContains, so the same side),
+// and lands in the one piece whose constraints all hold, or in none -- instead of every piece
+// testing its constraints on every fragment of the source. A source whose pieces do not form such
+// a trie (never from buildBspTree) has its pieces test their fragments directly.
+struct PieceTrie {
+    struct Node {
+        uint32_t plane = UINT32_MAX;  // the BSP node whose plane decides here; UINT32_MAX: a leaf
+        int32_t child[2] = {-1, -1};  // behind, front
+        uint32_t item = UINT32_MAX;   // at a leaf: the draw item (piece) that owns it
+    };
+    std::vector<Node> nodes{Node{}};
+    bool direct = false;
+
+    void insert(const BspTree &tree, uint32_t piece, uint32_t item) {
+        const BspPiece &p = tree.pieces[piece];
+        int32_t at = 0;
+        for (uint32_t i = 0; i < p.constraintCount && !direct; ++i) {
+            const BspConstraint &c = tree.constraints[p.firstConstraint + i];
+            Node &n = nodes[size_t(at)];
+            if (n.item != UINT32_MAX || (n.plane != UINT32_MAX && n.plane != c.node)) {
+                direct = true;
+                return;
+            }
+            n.plane = c.node;
+            const int side = c.front ? 1 : 0;
+            if (nodes[size_t(at)].child[side] < 0) {
+                nodes[size_t(at)].child[side] = int32_t(nodes.size());
+                nodes.push_back(Node{});
+            }
+            at = nodes[size_t(at)].child[side];
+        }
+        Node &leaf = nodes[size_t(at)];
+        if (leaf.plane != UINT32_MAX || leaf.item != UINT32_MAX) direct = true;
+        leaf.item = item;
+    }
+    uint32_t owner(const BspViewPlanes &planes, Vec3 pv) const {
+        int32_t at = 0;
+        while (nodes[size_t(at)].plane != UINT32_MAX) {
+            const double *q = &planes.plane[4 * size_t(nodes[size_t(at)].plane)];
+            const bool front = (q[0] * pv.x + q[1] * pv.y + q[2] * pv.z) + q[3] >= 0;
+            at = nodes[size_t(at)].child[front ? 1 : 0];
+            if (at < 0) return UINT32_MAX;
+        }
+        return nodes[size_t(at)].item;
+    }
 };
 
 ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, const BspTree *tree,
@@ -213,87 +254,91 @@ ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem>
     auto fragmentsOf = [&](uint32_t s) { return std::pair{fc.begin[v.screenBegin[s]], fc.begin[v.screenEnd[s]]}; };
     auto constrained = [&](const DrawItem &it) { return it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount; };
 
-    // Per split source: its nodes, then its fragments' side bits.
-    std::unordered_map<uint32_t, SourceSides> sides;
-    for (const DrawItem &it : items) {
-        if (!constrained(it)) continue;
-        SourceSides &ss = sides[it.source];
-        const BspPiece &p = tree->pieces[it.piece];
-        for (uint32_t i = 0; i < p.constraintCount; ++i) {
-            const uint32_t node = tree->constraints[p.firstConstraint + i].node;
-            if (std::find(ss.nodes.begin(), ss.nodes.end(), node) == ss.nodes.end()) ss.nodes.push_back(node);
-        }
-    }
-    std::vector<uint64_t> bits;
-    for (auto &[s, ss] : sides) {
-        if (ss.nodes.size() > 64) {
-            ss.direct = true;
-            continue;
-        }
-        const auto [f0, f1] = fragmentsOf(s);
-        ss.first = bits.size();
-        for (uint64_t f = f0; f < f1; ++f) {
-            const Vec3 pv = rays.point(fc.pixel[f], fc.depth[f]);
-            uint64_t b = 0;
-            for (size_t j = 0; j < ss.nodes.size(); ++j) {
-                const double *q = &planes->plane[4 * size_t(ss.nodes[j])];
-                const bool front = (q[0] * pv.x + q[1] * pv.y + q[2] * pv.z) + q[3] >= 0;
-                b |= uint64_t(front) << j;
-            }
-            bits.push_back(b);
-        }
-    }
+    // Per split source, the trie of its drawn pieces.
+    std::unordered_map<uint32_t, PieceTrie> tries;
+    for (size_t k = 0; k < items.size(); ++k)
+        if (constrained(items[k])) tries[items[k].source].insert(*tree, items[k].piece, uint32_t(k));
 
-    ItemFragments sel;
-    sel.begin.assign(items.size() + 1, 0);
+    // Per item its fragment count, then the lists in item order (counting sort: each source's
+    // fragments in ascending order into their owners' slots).
+    std::vector<uint32_t> owner(fc.pixel.size(), UINT32_MAX);  // per cache fragment of a trie source
+    std::vector<uint64_t> count(items.size(), 0);
+    std::unordered_map<size_t, std::vector<uint32_t>> directLists;
+    for (auto &[s, trie] : tries) {
+        if (trie.direct) continue;
+        const auto [f0, f1] = fragmentsOf(s);
+        for (uint64_t f = f0; f < f1; ++f) {
+            const uint32_t k = trie.owner(*planes, rays.point(fc.pixel[f], fc.depth[f]));
+            owner[f] = k;
+            if (k != UINT32_MAX) ++count[k];
+        }
+    }
     for (size_t k = 0; k < items.size(); ++k) {
         const DrawItem &it = items[k];
         const auto [f0, f1] = fragmentsOf(it.source);
         if (!constrained(it)) {
-            for (uint64_t f = f0; f < f1; ++f) sel.index.push_back(uint32_t(f));
-        } else if (const SourceSides &ss = sides.at(it.source); ss.direct) {
+            count[k] = f1 - f0;
+        } else if (tries.at(it.source).direct) {
+            std::vector<uint32_t> &list = directLists[k];
             for (uint64_t f = f0; f < f1; ++f)
                 if (bspPieceContains(*tree, *planes, it.piece, rays.point(fc.pixel[f], fc.depth[f])))
-                    sel.index.push_back(uint32_t(f));
-        } else {
-            // The piece's constraints as a mask of the source's nodes and the sides it wants.
-            uint64_t mask = 0, want = 0;
-            bool never = false;  // two constraints on one node wanting both sides: nothing matches
-            const BspPiece &p = tree->pieces[it.piece];
-            for (uint32_t i = 0; i < p.constraintCount; ++i) {
-                const BspConstraint &c = tree->constraints[p.firstConstraint + i];
-                const uint64_t bit = uint64_t(1) << (std::find(ss.nodes.begin(), ss.nodes.end(), c.node) - ss.nodes.begin());
-                never = never || ((mask & bit) && ((want & bit) != 0) != c.front);
-                mask |= bit;
-                if (c.front) want |= bit;
-            }
-            const uint64_t *b = bits.data() + ss.first;
-            if (!never)
-                for (uint64_t f = f0; f < f1; ++f)
-                    if ((b[f - f0] & mask) == want) sel.index.push_back(uint32_t(f));
+                    list.push_back(uint32_t(f));
+            count[k] = list.size();
         }
-        sel.begin[k + 1] = sel.index.size();
+    }
+    ItemFragments sel;
+    sel.begin.assign(items.size() + 1, 0);
+    for (size_t k = 0; k < items.size(); ++k) sel.begin[k + 1] = sel.begin[k] + count[k];
+    sel.index.resize(sel.begin.back());
+    std::vector<uint64_t> next(sel.begin.begin(), sel.begin.end() - 1);
+    for (size_t k = 0; k < items.size(); ++k) {
+        const DrawItem &it = items[k];
+        const auto [f0, f1] = fragmentsOf(it.source);
+        if (!constrained(it)) {
+            for (uint64_t f = f0; f < f1; ++f) sel.index[next[k]++] = uint32_t(f);
+        } else if (auto d = directLists.find(k); d != directLists.end()) {
+            for (uint32_t f : d->second) sel.index[next[k]++] = f;
+        }
+    }
+    for (auto &[s, trie] : tries) {
+        if (trie.direct) continue;
+        const auto [f0, f1] = fragmentsOf(s);
+        for (uint64_t f = f0; f < f1; ++f)
+            if (owner[f] != UINT32_MAX) sel.index[next[owner[f]]++] = uint32_t(f);
     }
     return sel;
 }
 
-// The per-pixel results of a draw, and its counts.
+// The per-pixel results of a draw, and its counts. With the depth test the depth buffer is this
+// thread's scratch buffer, reused from draw to draw and view to view (a fresh 1080p buffer of
+// doubles cost more in page faults than the whole draw), and a pixel counts as covered when its
+// first fragment passes (from +inf: every finite depth passes, and id is never 0 once written);
+// the id buffer is kept only when the caller wants it. Without the depth test every fragment
+// writes, and the ids are needed to count the covered pixels.
+template <bool kDepthTest>
 struct DrawTarget {
-    std::vector<double> depth;
+    double *depth = nullptr;
     std::vector<uint32_t> id;
-    uint64_t fragments = 0, passes = 0;
+    bool keepIds;
+    uint64_t fragments = 0, passes = 0, covered = 0;
 
-    DrawTarget(size_t pixels, bool depthTest)
-        : depth(depthTest ? pixels : 0, std::numeric_limits<double>::infinity()), id(pixels, 0) {}
-    template <bool kDepthTest>
+    DrawTarget(size_t pixels, bool keepIds_) : keepIds(keepIds_) {
+        if constexpr (kDepthTest) {
+            thread_local std::vector<double> scratch;
+            scratch.assign(pixels, std::numeric_limits<double>::infinity());
+            depth = scratch.data();
+        }
+        if (!kDepthTest || keepIds) id.assign(pixels, 0);
+    }
     void write(uint32_t pixel, double d, uint32_t current) {
         ++fragments;
         if constexpr (!kDepthTest) {
             id[pixel] = current;
             ++passes;
         } else if (d < depth[pixel]) {
+            covered += depth[pixel] == std::numeric_limits<double>::infinity();
             depth[pixel] = d;
-            id[pixel] = current;
+            if (keepIds) id[pixel] = current;
             ++passes;
         }
     }
@@ -301,7 +346,11 @@ struct DrawTarget {
         DrawStats st;
         st.fragments = fragments;
         st.depthPasses = passes;
-        for (uint32_t i : id) st.coveredPixels += i != 0;
+        if constexpr (kDepthTest) {
+            st.coveredPixels = covered;
+        } else {
+            for (uint32_t i : id) st.coveredPixels += i != 0;
+        }
         st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
         st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
         if (idsOut) *idsOut = std::move(id);
@@ -316,18 +365,19 @@ template <bool kDepthTest>
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, const ItemFragments *sel,
                      std::vector<uint32_t> *idsOut) {
     const FragmentCache &fc = *v.fragments;
-    DrawTarget target(size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0)), kDepthTest);
+    DrawTarget<kDepthTest> target(size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0)),
+                                  idsOut != nullptr);
     for (size_t k = 0; k < items.size(); ++k) {
         const uint32_t current = items[k].source + 1;
         if (sel) {
             for (uint64_t j = sel->begin[k]; j < sel->begin[k + 1]; ++j) {
                 const uint32_t f = sel->index[j];
-                target.write<kDepthTest>(fc.pixel[f], fc.depth[f], current);
+                target.write(fc.pixel[f], fc.depth[f], current);
             }
         } else {
             const uint32_t s = items[k].source;
             for (uint64_t f = fc.begin[v.screenBegin[s]]; f < fc.begin[v.screenEnd[s]]; ++f)
-                target.write<kDepthTest>(fc.pixel[f], fc.depth[f], current);
+                target.write(fc.pixel[f], fc.depth[f], current);
         }
     }
     return target.finish(idsOut);
@@ -485,54 +535,43 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
     for (const PairTri &t : tris) disjoint += uint64_t(zmins.end() - std::upper_bound(zmins.begin(), zmins.end(), t.zmax));
     r.pairs = uint64_t(n) * (n - (n > 0)) / 2 - disjoint;
 
-    // Pairs whose bounding rectangles overlap too, enumerated per 32-pixel screen tile: a pair is
-    // handled in the tile holding the lower-right-most of the two rectangles' top-left corners
-    // (inside both rectangles; tile indices clamped to the grid, which keeps that true), so once.
-    constexpr double kTile = 32;
-    const int ntx = std::max(1, (v.cam.width + 31) / 32), nty = std::max(1, (v.cam.height + 31) / 32);
-    auto tileX = [&](double x) { return std::clamp(int(std::floor(x / kTile)), 0, ntx - 1); };
-    auto tileY = [&](double y) { return std::clamp(int(std::floor(y / kTile)), 0, nty - 1); };
-    std::vector<std::vector<uint32_t>> tiles(size_t(ntx) * size_t(nty));
-    for (uint32_t i = 0; i < n; ++i)
-        for (int ty = tileY(tris[i].by0); ty <= tileY(tris[i].by1); ++ty)
-            for (int tx = tileX(tris[i].bx0); tx <= tileX(tris[i].bx1); ++tx) tiles[size_t(ty) * ntx + tx].push_back(i);
+    // Pairs whose bounding rectangles overlap too: their closed boxes (screen rectangle x depth
+    // range) intersect. CGAL's box intersection (a streaming segment tree, O(n log^3 n + k))
+    // reports each such pair once, in an order that does not matter: each pair's outcome depends on
+    // the pair alone, and the counts are sums.
+    using Box = CGAL::Box_intersection_d::Box_with_handle_d<double, 3, const PairTri *,
+                                                            CGAL::Box_intersection_d::ID_FROM_HANDLE>;
+    std::vector<Box> boxes;
+    boxes.reserve(n);
+    for (const PairTri &t : tris) boxes.emplace_back(CGAL::Bbox_3(t.bx0, t.by0, t.zmin, t.bx1, t.by1, t.zmax), &t);
     uint64_t boundsOverlap = 0;
-    for (int ty = 0; ty < nty; ++ty)
-        for (int tx = 0; tx < ntx; ++tx) {
-            std::vector<uint32_t> &list = tiles[size_t(ty) * ntx + tx];
-            std::sort(list.begin(), list.end(), [&](uint32_t a, uint32_t b) {
-                return tris[a].zmin < tris[b].zmin || (tris[a].zmin == tris[b].zmin && a < b);
-            });
-            for (size_t i = 0; i < list.size(); ++i) {
-                const PairTri &A = tris[list[i]];
-                for (size_t j = i + 1; j < list.size() && tris[list[j]].zmin <= A.zmax; ++j) {
-                    const PairTri &B = tris[list[j]];
-                    if (A.bx1 < B.bx0 || B.bx1 < A.bx0 || A.by1 < B.by0 || B.by1 < A.by0) continue;
-                    if (tileX(std::max(A.bx0, B.bx0)) != tx || tileY(std::max(A.by0, B.by0)) != ty) continue;
-                    ++boundsOverlap;
-                    const PairTri &Pt = A.rank < B.rank ? A : B;  // drawn first: the farther by the sort
-                    const PairTri &Qt = A.rank < B.rank ? B : A;
-                    const uint32_t P = Pt.src, Q = Qt.src;
-                    const int eyeQ = eyeSide(scene, v.cam, Q), eyeP = eyeSide(scene, v.cam, P);
-                    if (allOnSide(scene, Q, P, -eyeQ)) {
-                        ++r.behindPlane;
-                    } else if (allOnSide(scene, P, Q, eyeP)) {
-                        ++r.inFrontOfPlane;
-                    } else if (projectionsDisjoint(v.all, v.screenBegin[P], v.screenEnd[P], v.screenBegin[Q],
-                                                   v.screenEnd[Q])) {
-                        ++r.projectionsDisjoint;
-                    } else if (allOnSide(scene, P, Q, -eyeP)) {  // Newell's swap: Q is the farther one
-                        ++r.behindPlane;
-                        ++r.swapped;
-                    } else if (allOnSide(scene, Q, P, eyeQ)) {
-                        ++r.inFrontOfPlane;
-                        ++r.swapped;
-                    } else {
-                        ++r.unresolved;
-                    }
-                }
-            }
+    // The eye's side of each drawn triangle's plane, once per triangle instead of once per pair.
+    std::vector<int8_t> eyeSideOf(scene.triangleCount(), 0);
+    for (const PairTri &t : tris) eyeSideOf[t.src] = int8_t(eyeSide(scene, v.cam, t.src));
+    auto classify = [&](const Box &a, const Box &b) {
+        const PairTri &A = *a.handle(), &B = *b.handle();
+        ++boundsOverlap;
+        const PairTri &Pt = A.rank < B.rank ? A : B;  // drawn first: the farther by the sort
+        const PairTri &Qt = A.rank < B.rank ? B : A;
+        const uint32_t P = Pt.src, Q = Qt.src;
+        const int eyeQ = eyeSideOf[Q], eyeP = eyeSideOf[P];
+        if (allOnSide(scene, Q, P, -eyeQ)) {
+            ++r.behindPlane;
+        } else if (allOnSide(scene, P, Q, eyeP)) {
+            ++r.inFrontOfPlane;
+        } else if (projectionsDisjoint(v.all, v.screenBegin[P], v.screenEnd[P], v.screenBegin[Q], v.screenEnd[Q])) {
+            ++r.projectionsDisjoint;
+        } else if (allOnSide(scene, P, Q, -eyeP)) {  // Newell's swap: Q is the farther one
+            ++r.behindPlane;
+            ++r.swapped;
+        } else if (allOnSide(scene, Q, P, eyeQ)) {
+            ++r.inFrontOfPlane;
+            ++r.swapped;
+        } else {
+            ++r.unresolved;
         }
+    };
+    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), classify);
     r.boundsDisjoint = r.pairs - boundsOverlap;
     r.ms = t0.ms();
     return r;

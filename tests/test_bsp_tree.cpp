@@ -4,6 +4,8 @@
 // against the reference visibility. Suite BspTree*.
 #include <gtest/gtest.h>
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -84,6 +86,65 @@ TEST(BspTree, Orient3dSignAndExactness) {
     EXPECT_EQ(orient3d(a, b, c, onPlane), 0);
     EXPECT_EQ(orient3d(a, b, c, {onPlane.x, onPlane.y, std::nextafter(a.z, 2e5)}), 1);
     EXPECT_EQ(orient3d(a, b, c, {onPlane.x, onPlane.y, std::nextafter(a.z, 0.0)}), -1);
+    // The exact zeros decided before CGAL (a corner repeated; four points on one axis-aligned
+    // plane), against the truth, and one ulp off the plane the sign is still exact: random
+    // level-sized coordinates on planes x, y or z = const.
+    uint64_t state = 42;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53 * 2e4 - 1e4;
+    };
+    for (int i = 0; i < 2000; ++i) {
+        const int axis = i % 3;
+        const double k = next();
+        auto onAxisPlane = [&] {
+            Vec3 p{next(), next(), next()};
+            p[axis] = k;
+            return p;
+        };
+        const Vec3 p0 = onAxisPlane(), p1 = onAxisPlane(), p2 = onAxisPlane(), q = onAxisPlane();
+        EXPECT_EQ(orient3d(p0, p1, p2, q), 0);
+        EXPECT_EQ(orient3d(p0, p1, p2, p1), 0);
+        EXPECT_EQ(orient3d(p0, p1, q, p0), 0);
+        // Off the plane by one ulp: the sign of the normal's component times the offset's.
+        const Vec3 n = cross(p1 - p0, p2 - p0);
+        if (n[axis] == 0) continue;
+        Vec3 up = q;
+        up[axis] = std::nextafter(k, 1e30);
+        EXPECT_EQ(orient3d(p0, p1, p2, up), n[axis] > 0 ? 1 : -1) << i;
+    }
+}
+
+// orient3d's own stages (filter, exact zeros, 128-bit integers) against CGAL's exact predicate
+// alone, on inputs that reach every stage: points on random planes through grid and float
+// coordinates (coplanar up to rounding), snapped to grids of several sizes, and exact copies.
+TEST(BspTree, Orient3dAgreesWithCgal) {
+    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+    uint64_t state = 7;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    };
+    int decided = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const double grid = std::ldexp(1.0, int(next() * 12) - 6);  // 1/64 .. 32
+        const double scale = std::ldexp(1.0, int(next() * 20));      // 1 .. 2^19
+        auto snap = [&](double x) { return i % 4 == 0 ? x : std::round(x / grid) * grid; };
+        const Vec3 o{snap(next() * scale), snap(next() * scale), snap(next() * scale)};
+        const Vec3 u{snap(next() * 64 - 32), snap(next() * 64 - 32), snap(next() * 64 - 32)};
+        const Vec3 w{snap(next() * 64 - 32), snap(next() * 64 - 32), snap(next() * 64 - 32)};
+        const Vec3 a = o, b = o + u, c = o + w;
+        const double s = next() * 4 - 2, t = next() * 4 - 2;
+        Vec3 d = o + u * s + w * t;  // on the plane up to rounding
+        d = {snap(d.x), snap(d.y), snap(d.z)};
+        if (i % 3 == 0) d = i % 2 ? b : c;
+        const CGAL::Orientation e = CGAL::orientation(K::Point_3(a.x, a.y, a.z), K::Point_3(b.x, b.y, b.z),
+                                                      K::Point_3(c.x, c.y, c.z), K::Point_3(d.x, d.y, d.z));
+        const int want = e == CGAL::POSITIVE ? 1 : (e == CGAL::NEGATIVE ? -1 : 0);
+        ASSERT_EQ(orient3d(a, b, c, d), want) << i;
+        decided += want == 0;
+    }
+    EXPECT_GT(decided, 5000);  // many exact zeros: the stages before CGAL were exercised
 }
 
 TEST(BspTree, EmptyAndSingle) {
