@@ -35,15 +35,17 @@ bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edge
     }
     // Filter: n.e + k in double, with a bound on its rounding error that covers the computation
     // of n and k from the vertices too (pbrt-style gamma bound, generous factor).
+    // The magnitudes come precomputed per triangle (Scene::planeBounds: the same operations on the
+    // same values), so the common case reads the plane and two numbers, never the vertices.
     const Vec3 &e = cam.eye;
     const double s = dot(n, e) + p[3];
-    const uint32_t *ix = &scene.indices[3 * size_t(t)];
-    const Vec3 v0 = scene.positions[ix[0]], v1 = scene.positions[ix[1]], v2 = scene.positions[ix[2]];
-    const double mag = (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z)) *
-                       (maxAbs(e) + std::fmax(maxAbs(v0), std::fmax(maxAbs(v1), maxAbs(v2))));
+    const double *b = &scene.planeBounds[2 * size_t(t)];
+    const double mag = b[0] * (maxAbs(e) + b[1]);
     const double err = gamma(12) * mag;
     if (s > err) return true;
     if (s < -err) return false;
+    const uint32_t *ix = &scene.indices[3 * size_t(t)];
+    const Vec3 v0 = scene.positions[ix[0]], v1 = scene.positions[ix[1]], v2 = scene.positions[ix[2]];
     const int side = exactSide(v0, v1, v2, e);
     if (side == 0 && edgeOn) *edgeOn = true;
     return side > 0;
@@ -83,6 +85,11 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
     TriangleLists &l = r.kept;
     BackfaceStats &st = r.stats;
     l.objects.reserve(objects.size());
+    uint64_t total = 0;
+    for (uint32_t o : objects) total += scene.objects[o].triEnd - scene.objects[o].triBegin;
+    l.triangles.reserve(total);
+    const double eyeMax = maxAbs(cam.eye);
+    const double kGamma12 = gamma(12);
     for (uint32_t o : objects) {
         const SceneObject &ob = scene.objects[o];
         const uint32_t begin = uint32_t(l.triangles.size());
@@ -93,10 +100,21 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
                                scene.objectTriangles.begin() + ob.triEnd);
         } else {
             st.trianglesTested += n;
+            // isFrontFacing's filter inlined for the perspective case (the same operations, so the
+            // same decisions); only where it cannot decide does the full test run.
+            const uint32_t *tris = scene.objectTriangles.data();
             for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) {
-                const uint32_t t = scene.objectTriangles[i];
+                const uint32_t t = tris[i];
+                int side = 0;  // +1 front, -1 back, 0 undecided by the filter
+                if (!cam.orthographic) {
+                    const double *p = &scene.planes[4 * size_t(t)];
+                    const double *b = &scene.planeBounds[2 * size_t(t)];
+                    const double s = dot(Vec3{p[0], p[1], p[2]}, cam.eye) + p[3];
+                    const double err = kGamma12 * (b[0] * (eyeMax + b[1]));
+                    side = s > err ? 1 : (s < -err ? -1 : 0);
+                }
                 bool edgeOn = false;
-                if (isFrontFacing(scene, t, cam, &edgeOn)) {
+                if (side > 0 || (side == 0 && isFrontFacing(scene, t, cam, &edgeOn))) {
                     l.triangles.push_back(t);
                 } else {
                     r.culled.push_back(t);

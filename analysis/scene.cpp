@@ -94,6 +94,7 @@ bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *outSce
     s.indices.assign(total * 3, 0);  // excluded triangles keep {0, 0, 0} (see scene.h)
     s.triangleObject.assign(total, kExcludedTriangle);
     s.planes.assign(total * 4, 0.0);  // excluded triangles keep the plane (0, 0, 0, 0)
+    s.planeBounds.assign(total * 2, 0.0);
     s.objectTriangles.reserve(total);
     s.positions.reserve(total / 2 + 16);  // a closed mesh has about half as many vertices as triangles
 
@@ -146,6 +147,8 @@ bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *outSce
             }
             double *p = &s.planes[4 * id];
             p[0] = n.x, p[1] = n.y, p[2] = n.z, p[3] = k;
+            s.planeBounds[2 * id] = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
+            s.planeBounds[2 * id + 1] = std::fmax(maxAbs(v0), std::fmax(maxAbs(v1), maxAbs(v2)));
             items.push_back({v0 + v1 + v2, uint32_t(id)});
         }
 

@@ -227,6 +227,9 @@ struct Scene {
     std::vector<uint32_t> objectTriangles;// triangles of each culling object, contiguous per object
     std::vector<double> planes;           // 4 per source triangle: world plane n.x n.y n.z k, n.p + k = 0,
                                           //   n = (v1 - v0) x (v2 - v0) (front = CCW side)
+    std::vector<double> planeBounds;      // 2 per source triangle: |n.x| + |n.y| + |n.z| and the
+                                          //   largest |coordinate| of its vertices (the backface
+                                          //   test's rounding bound, isFrontFacing); 0 when excluded
     std::vector<SceneObject> objects;
     std::vector<SourceObject> sources;
     std::vector<Material> materials;

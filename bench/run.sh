@@ -5,7 +5,7 @@
 #
 #   bash bench/run.sh                      # everything (the 10M x 64 views case alone takes minutes)
 #   bash bench/run.sh --quick              # 3 repetitions; scaling without 10M triangles and 64 views
-#   bash bench/run.sh --sections zbuffer,llvmpipe,raycast,load,analyze,scaling [--reps N] [--keep]
+#   bash bench/run.sh --sections zbuffer,llvmpipe,raycast,pipeline,load,analyze,level,scaling [--reps N] [--keep]
 #
 # Builds visaudit and bench_table (Release) in $BUILD (default: build/), then runs
 # $BUILD/bench/bench_table; progress goes to stderr, the table to stdout. Floors are printed as
@@ -17,4 +17,4 @@ if [ ! -f "$BUILD/CMakeCache.txt" ]; then
   cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
 cmake --build "$BUILD" -j"$(nproc)" --target visaudit bench_table >&2
-exec "$BUILD/bench/bench_table" --visaudit "$BUILD/visaudit" "$@"
+exec "$BUILD/bench/bench_table" --visaudit "$BUILD/visaudit" --data "$ROOT/data" "$@"
