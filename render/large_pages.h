@@ -14,9 +14,10 @@
 
 namespace va {
 
-// v = n copies of x, its memory advised to be backed by huge pages before the first touch.
+// Room for n elements in v (empty), its memory advised to be backed by huge pages before the
+// first touch: pages are faulted in only as elements arrive, 2 MiB at a time.
 template <class T>
-void assignOnLargePages(std::vector<T> &v, size_t n, T x) {
+void reserveOnLargePages(std::vector<T> &v, size_t n) {
     v.clear();
     v.reserve(n);  // allocates without touching the pages
 #ifdef MADV_HUGEPAGE
@@ -25,6 +26,12 @@ void assignOnLargePages(std::vector<T> &v, size_t n, T x) {
     const uintptr_t e = (reinterpret_cast<uintptr_t>(v.data() + n)) & ~(kPage - 1);
     if (e > b) madvise(reinterpret_cast<void *>(b), e - b, MADV_HUGEPAGE);
 #endif
+}
+
+// v = n copies of x, its memory advised to be backed by huge pages before the first touch.
+template <class T>
+void assignOnLargePages(std::vector<T> &v, size_t n, T x) {
+    reserveOnLargePages(v, n);
     v.assign(n, x);
 }
 

@@ -24,15 +24,6 @@
 
 namespace va {
 
-int32_t toFixed(double pixelCoordinate) {
-    // Scaling by 2^kSubpixelBits is exact; nearbyint rounds half to even in the default mode.
-    const double s = std::nearbyint(pixelCoordinate * kSubpixelOne);
-    // Saturate (NaN goes to the minimum): the rasterizer rejects such coordinates (kMaxFixed, raster_core.h).
-    if (!(s > -2147483648.0)) return std::numeric_limits<int32_t>::min();
-    if (s > 2147483647.0) return std::numeric_limits<int32_t>::max();
-    return int32_t(s);
-}
-
 namespace {
 
 // ---- The tiled path (docs/rasterizer.md: Tiles) ----

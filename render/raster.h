@@ -33,8 +33,20 @@ struct ScreenTriangles {
     void clear() { xy.clear(); source.clear(); plane.clear(); planes.clear(); }
 };
 
-// Converts pixel coordinates to the rasterizer's fixed point (round to nearest, ties to even).
-int32_t toFixed(double pixelCoordinate);
+// Converts pixel coordinates to the rasterizer's fixed point (round to nearest, ties to even),
+// saturating to int32 (NaN to the minimum). Inline: the clipper calls it twice per vertex.
+// For |x| < 2^51, (x + 1.5 2^52) - 1.5 2^52 is x rounded to an integer in the default rounding
+// mode (the sum lies in [2^52, 2^53), where the spacing of doubles is 1, and 1.5 2^52 is even, so
+// ties go to even as for x itself; the subtraction is exact): nearbyint's result without its call.
+// Larger magnitudes are integers already and saturate below.
+inline int32_t toFixed(double pixelCoordinate) {
+    const double x = pixelCoordinate * kSubpixelOne;  // exact: a power of two
+    constexpr double kRound = 0x1.8p52;
+    const double s = (x < 0x1p51 && x > -0x1p51) ? (x + kRound) - kRound : x;
+    if (!(s > -2147483648.0)) return INT32_MIN;
+    if (s > 2147483647.0) return INT32_MAX;
+    return int32_t(s);
+}
 
 struct ZBufferSettings {
     DepthEncoder encoder;       // the view's depth format bound to its near/far

@@ -178,6 +178,28 @@ TEST(RasterFixed, ToFixedRoundsHalfToEven) {
     EXPECT_EQ(toFixed(1e12), 2147483647);
     EXPECT_EQ(toFixed(-1e12), -2147483647 - 1);
     EXPECT_EQ(toFixed(NAN), -2147483647 - 1);
+    EXPECT_EQ(toFixed(INFINITY), 2147483647);
+    EXPECT_EQ(toFixed(-INFINITY), -2147483647 - 1);
+    // The inline rounding against nearbyint (round half to even in the default mode): random
+    // pixel coordinates over the clipper's range, and every tie of a few thousand units.
+    uint64_t state = 3;
+    auto reference = [](double p) {
+        const double s = std::nearbyint(p * kSubpixelOne);
+        if (!(s > -2147483648.0)) return int32_t(INT32_MIN);
+        if (s > 2147483647.0) return int32_t(INT32_MAX);
+        return int32_t(s);
+    };
+    for (int i = 0; i < 200000; ++i) {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        const double p = (double(state >> 11) * 0x1p-53 - 0.5) * std::ldexp(1.0, int(state % 40));
+        ASSERT_EQ(toFixed(p), reference(p)) << p;
+    }
+    for (int u = -5000; u <= 5000; ++u) {
+        const double tie = (u + 0.5) / kSubpixelOne;
+        ASSERT_EQ(toFixed(tie), reference(tie)) << tie;
+        ASSERT_EQ(toFixed(std::nextafter(tie, 1e9)), reference(std::nextafter(tie, 1e9)));
+        ASSERT_EQ(toFixed(std::nextafter(tie, -1e9)), reference(std::nextafter(tie, -1e9)));
+    }
 }
 
 // (a) Two triangles forming a quad: both diagonals, every winding of each half and every rotation
