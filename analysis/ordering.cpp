@@ -247,8 +247,10 @@ struct PieceTrie {
     }
 };
 
-ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, const BspTree *tree,
-                              const BspViewPlanes *planes) {
+// `sel` is filled (its storage reused: the callers keep one per thread, so a view's lists do not
+// fault fresh pages in).
+void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, const BspTree *tree,
+                     const BspViewPlanes *planes, ItemFragments &sel) {
     const FragmentCache &fc = *v.fragments;
     const PixelRays rays(v.cam);
     auto fragmentsOf = [&](uint32_t s) { return std::pair{fc.begin[v.screenBegin[s]], fc.begin[v.screenEnd[s]]}; };
@@ -261,7 +263,9 @@ ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem>
 
     // Per item its fragment count, then the lists in item order (counting sort: each source's
     // fragments in ascending order into their owners' slots).
-    std::vector<uint32_t> owner(fc.pixel.size(), UINT32_MAX);  // per cache fragment of a trie source
+    // Per cache fragment of a trie source (written before it is read; per-thread storage).
+    thread_local std::vector<uint32_t> owner;
+    if (owner.size() < fc.pixel.size()) owner.resize(fc.pixel.size());
     std::vector<uint64_t> count(items.size(), 0);
     std::unordered_map<size_t, std::vector<uint32_t>> directLists;
     for (auto &[s, trie] : tries) {
@@ -286,7 +290,6 @@ ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem>
             count[k] = list.size();
         }
     }
-    ItemFragments sel;
     sel.begin.assign(items.size() + 1, 0);
     for (size_t k = 0; k < items.size(); ++k) sel.begin[k + 1] = sel.begin[k] + count[k];
     sel.index.resize(sel.begin.back());
@@ -306,7 +309,6 @@ ItemFragments selectFragments(const OrderingView &v, const std::vector<DrawItem>
         for (uint64_t f = f0; f < f1; ++f)
             if (owner[f] != UINT32_MAX) sel.index[next[owner[f]]++] = uint32_t(f);
     }
-    return sel;
 }
 
 // The per-pixel results of a draw, and its counts. With the depth test the depth buffer is this
@@ -363,11 +365,12 @@ struct DrawTarget {
 // rasterizing draw (within a triangle the order is immaterial: no pixel twice), so the same result.
 template <bool kDepthTest>
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, const ItemFragments *sel,
-                     std::vector<uint32_t> *idsOut) {
+                     std::vector<uint32_t> *idsOut, bool reverse) {
     const FragmentCache &fc = *v.fragments;
     DrawTarget<kDepthTest> target(size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0)),
                                   idsOut != nullptr);
-    for (size_t k = 0; k < items.size(); ++k) {
+    for (size_t j = 0; j < items.size(); ++j) {
+        const size_t k = reverse ? items.size() - 1 - j : j;
         const uint32_t current = items[k].source + 1;
         if (sel) {
             for (uint64_t j = sel->begin[k]; j < sel->begin[k + 1]; ++j) {
@@ -383,9 +386,11 @@ DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, 
     return target.finish(idsOut);
 }
 
+// The items in order, or (reverse) from the last to the first.
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
-                     const ItemFragments *sel, std::vector<uint32_t> *idsOut) {
-    return depthTest ? drawCached<true>(v, items, sel, idsOut) : drawCached<false>(v, items, sel, idsOut);
+                     const ItemFragments *sel, std::vector<uint32_t> *idsOut, bool reverse = false) {
+    return depthTest ? drawCached<true>(v, items, sel, idsOut, reverse)
+                     : drawCached<false>(v, items, sel, idsOut, reverse);
 }
 
 bool hasConstrainedPiece(const std::vector<DrawItem> &items, const BspTree *tree) {
@@ -400,9 +405,9 @@ DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items,
                       const BspViewPlanes *planes, std::vector<uint32_t> *idsOut) {
     const Stopwatch t0;
     if (v.fragments) {
-        ItemFragments sel;
+        thread_local ItemFragments sel;
         const bool pieces = hasConstrainedPiece(items, tree);
-        if (pieces) sel = selectFragments(v, items, tree, planes);
+        if (pieces) selectFragments(v, items, tree, planes, sel);
         DrawStats st = drawCached(v, items, depthTest, pieces ? &sel : nullptr, idsOut);
         st.ms = t0.ms() + v.fragments->rasterMs;
         return st;
@@ -618,24 +623,15 @@ BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, 
         // Both orders draw the same pieces' fragments: the piece test runs once, and each order's
         // time is its own pass plus that selection plus the rasterization that recorded them.
         const Stopwatch ts;
-        ItemFragments sel = selectFragments(v, items, &tree, &planes);
+        thread_local ItemFragments sel;
+        selectFragments(v, items, &tree, &planes, sel);
         const double selectMs = ts.ms() + v.fragments->rasterMs;
         const Stopwatch tb;
         r.backToFront = drawCached(v, items, false, &sel, &r.id);
         r.backToFront.ms = tb.ms() + selectMs;
-        // Front to back is the reverse order: reverse the items and their fragment lists.
-        std::reverse(items.begin(), items.end());
-        ItemFragments rev;
-        rev.begin.resize(sel.begin.size());
-        rev.index.reserve(sel.index.size());
-        for (size_t k = items.size(); k-- > 0;) {
-            rev.begin[items.size() - 1 - k] = rev.index.size();
-            rev.index.insert(rev.index.end(), sel.index.begin() + int64_t(sel.begin[k]),
-                             sel.index.begin() + int64_t(sel.begin[k + 1]));
-        }
-        rev.begin.back() = rev.index.size();
+        // Front to back: the same items and lists, from the last to the first.
         const Stopwatch tf;
-        r.frontToBack = drawCached(v, items, true, &rev, nullptr);
+        r.frontToBack = drawCached(v, items, true, &sel, nullptr, true);
         r.frontToBack.ms = tf.ms() + selectMs;
     } else {
         r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
@@ -686,13 +682,16 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
 
     r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);
     r.bsp = bspForView(v, ref, tree);
+    std::vector<uint32_t> submittedIds;
 
     // Overdraw by draw order, each with the depth test.
     {
         std::vector<DrawItem> submitted;
         for (size_t t = 0; t < v.all.size(); ++t)
             if (submitted.empty() || submitted.back().source != v.all.source[t]) submitted.push_back({v.all.source[t]});
-        r.overdrawByOrder.push_back({"submitted", drawInOrder(v, submitted, true, nullptr, nullptr, nullptr)});
+        // With the fragment cache this draw is also the z-buffer row below (kept ids).
+        r.overdrawByOrder.push_back(
+            {"submitted", drawInOrder(v, submitted, true, nullptr, nullptr, v.fragments ? &submittedIds : nullptr)});
 
         std::vector<DrawItem> backToFront;
         for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
@@ -728,7 +727,25 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     // The z-buffer as the pipeline's audit runs it (double depth, single-sided, submission order).
     OrderingRow zrow;
     zrow.method = "zbuffer";
-    {
+    if (v.fragments) {
+        // The z-buffer with exact depth (rasterize's exactDepth: LESS on the double view depth, the
+        // first drawn of equal depths stays) in submission order is the "submitted" draw above:
+        // the same fragments through the same test, so the same ids and passes. Its overdraw
+        // divides by the pixels holding a fragment, as the z-buffer's statistics do.
+        const Stopwatch tz;
+        std::vector<uint8_t> touched(pixels, 0);
+        for (uint32_t p : v.fragments->pixel) touched[p] = 1;
+        uint64_t covered = 0;
+        for (uint8_t t : touched) covered += t;
+        const DrawStats &sub = r.overdrawByOrder[0].stats;
+        zrow.drawMs = sub.ms + tz.ms();
+        const PixelComparison c = compareWithReference(v, ref, submittedIds);
+        zrow.wrongPixels = c.wrongPixels;
+        zrow.tiePixels = c.tiePixels;
+        zrow.edgePixels = c.edgePixels;
+        zrow.overdraw = covered ? double(sub.depthPasses) / double(covered) : 0;
+        zrow.memoryBytes = pixels * (sizeof(uint32_t) + sizeof(double));  // ids and depths
+    } else {
         ZBufferSettings zs;
         zs.encoder = makeDepthEncoder(DepthFormat::f32, cam.nearZ, cam.farZ);
         zs.orthographic = cam.orthographic;

@@ -309,6 +309,15 @@ void checkScene(const Scene &s, const std::vector<ViewSpec> &views, const std::s
         ASSERT_EQ(c.overdrawByOrder.size(), r.overdrawByOrder.size());
         for (size_t k = 0; k < r.overdrawByOrder.size(); ++k)
             same(c.overdrawByOrder[k].stats, r.overdrawByOrder[k].stats, r.overdrawByOrder[k].order);
+        // The table too (with the cache, the z-buffer row is the submitted draw, not a rasterize()).
+        ASSERT_EQ(c.table.size(), r.table.size());
+        for (size_t k = 0; k < r.table.size(); ++k) {
+            EXPECT_EQ(c.table[k].wrongPixels, r.table[k].wrongPixels) << r.table[k].method;
+            EXPECT_EQ(c.table[k].tiePixels, r.table[k].tiePixels) << r.table[k].method;
+            EXPECT_EQ(c.table[k].edgePixels, r.table[k].edgePixels) << r.table[k].method;
+            EXPECT_EQ(c.table[k].overdraw, r.table[k].overdraw) << r.table[k].method;
+            EXPECT_EQ(c.table[k].memoryBytes, r.table[k].memoryBytes) << r.table[k].method;
+        }
     }
 }
 
