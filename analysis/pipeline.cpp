@@ -408,7 +408,9 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     const EffectPlan plan = planEffects(scene, s.effects);
     if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;
     if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) {
-        perPixel += 22 + 12 * kOrderingCachedFragmentsPerPixel;  // + the reference's fragment cache
+        // + the reference's fragment cache (12 bytes a fragment), and the ordering's per-thread
+        // scratch: a depth buffer (8) and the BSP's piece lists and owners (4 bytes a fragment, 3x).
+        perPixel += 22 + 12 * kOrderingCachedFragmentsPerPixel + 8 + 12 * kOrderingCachedFragmentsPerPixel;
         // The A-buffer's fragments: a level's depth complexity is a few layers; the pool itself is
         // counted before it is allocated (--max-abuffer-list), 20 bytes a fragment.
         if (plan.abuffer.run) perPixel += 36 + 4 * sizeof(ABufferFragment);
