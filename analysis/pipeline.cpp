@@ -375,7 +375,9 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
               uint64_t(scene.objects.size()) * (sizeof(SceneObject) + 32) +
               uint64_t(scene.sources.size()) * (sizeof(SourceObject) + 64);
     if (scene.bsp) m.scene += bytesOf(scene.bsp->pvs) + bytesOf(scene.bsp->leafFaces) + bytesOf(scene.bsp->nodes) +
-                              bytesOf(scene.bsp->leafs) + bytesOf(scene.bsp->planes);
+                              bytesOf(scene.bsp->leafs) + bytesOf(scene.bsp->planes) +
+                              bytesOf(scene.bsp->triangleFace) + bytesOf(scene.bsp->faceLeafs) +
+                              bytesOf(scene.bsp->faceLeafsBegin);
 
     // Built once: the object BVH and grid (per object), Embree's float copy and BVH (about 100
     // bytes per triangle with the build's temporaries), per-triangle effect data, the ordering
@@ -509,6 +511,19 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         b.patchLevel = scene.bsp->patchLevel;
         b.hasPvs = scene.bsp->hasPvs();
         b.spawnPoints = spawnViews(scene).size();
+        for (size_t k = 1; k < scene.bsp->models.size(); ++k) {
+            const BspModel &m = scene.bsp->models[k];
+            if (m.drawn) {
+                b.drawnBrushEntities += m.entity >= 0;
+                continue;
+            }
+            ++b.notDrawnBrushEntities;
+            if (m.notDrawnFaces > 0)
+                b.notDrawn.push_back({uint32_t(k), m.entity, m.classname, m.entity >= 0 ? "trigger" : "no entity",
+                                      m.notDrawnFaces, m.notDrawnTriangles});
+        }
+        b.farPlane = scene.bsp->farPlane;
+        b.fogShader = scene.bsp->fogShader;
         out->bsp = b;
     }
     std::mutex errMutex;

@@ -907,6 +907,7 @@ struct HtmlWriter {
     void header(const std::vector<ViewScore> &worstFirst);
     void summary(const std::vector<ViewScore> &worstFirst);
     void planner();
+    void quakeMap();
     void depthAuditImage();
     void view(const Json *v, size_t pos);
     // eager: load with the page (the first views); else lazily, when scrolled near (reports of
@@ -1027,6 +1028,49 @@ void HtmlWriter::planner() {
         }
     if (!line.empty()) o += "<p id=\"planner-decisions\">" + line + "</p>";
     o += "<details><summary>all values</summary>" + genericJson(fx) + "</details></section>";
+}
+
+// A Quake 3 map's structure: clusters, the designed far plane, and the brush entities the engine
+// never draws (docs/quake3.md, "Brush entities" and "The far plane").
+void HtmlWriter::quakeMap() {
+    const Json *b = get(&report, {"scene", "bsp"});
+    if (!b || !b->is_object()) return;
+    o += "<section class=\"block\" id=\"quake-map\"><h2>Quake 3 map</h2><p>" + fmtCount(numOr(b, {"leafs"}, 0)) +
+         " leafs in " + fmtCount(numOr(b, {"clusters"}, 0)) + " clusters, " +
+         (isTrue(get(b, "has_pvs")) ? "with a PVS" : "<b>no PVS</b> (compiled without vis)") + "; " +
+         plural(numOr(b, {"brush_entities_drawn"}, 0), "drawn brush entity", "drawn brush entities") + " (" +
+         plural(numOr(b, {"model_faces"}, 0), "face", "faces") +
+         ", clustered by their box through the world's tree).</p>";
+    const Json *fp = get(b, "far_plane");
+    if (fp && fp->is_object())
+        o += "<p id=\"far-plane\">Designed far plane: <code>" + esc(str(get(fp, "key"))) + " " + esc(str(get(fp, "value"))) +
+             "</code> = " + fmtReal(numOr(fp, {"distance"}, 0)) +
+             " units. The compiler leaves portal pairs farther apart out of the PVS on purpose: views made from the map "
+             "use it as their far plane, and a surface the PVS leaves out that lies farther than it from the eye is "
+             "reported as hidden by design, not as a false cull.</p>";
+    else
+        o += "<p id=\"far-plane\" class=\"note\">No designed far plane (<code>_farplanedist</code>).</p>";
+    o += "<h3 id=\"not-drawn-entities\">Brush entities the engine never draws (not geometry)</h3>";
+    const Json *nd = get(b, "not_drawn_entities");
+    const double ndCount = numOr(b, {"brush_entities_not_drawn"}, 0);
+    if (nd && nd->is_array() && !nd->empty()) {
+        o += "<p>" + plural(numOr(b, {"not_drawn_entity_faces"}, 0), "face", "faces") + " (" +
+             plural(numOr(b, {"not_drawn_entity_triangles"}, 0), "triangle", "triangles") + ") of " +
+             plural(ndCount, "brush entity", "brush entities") +
+             " the game never draws (triggers, models no entity spawns) are kept out of the scene:</p>";
+        o += "<div class=\"scroll\"><table id=\"not-drawn-table\"><tr><th class=\"n\">model</th><th class=\"n\">entity</th>"
+             "<th>classname</th><th>why</th><th class=\"n\">faces</th><th class=\"n\">triangles</th></tr>";
+        for (const Json &e : *nd)
+            o += "<tr><td class=\"n\">*" + fmtValue(get(&e, "model")) + "</td><td class=\"n\">" + fmtValue(get(&e, "entity")) +
+                 "</td><td>" + esc(str(get(&e, "classname"))) + "</td><td>" + esc(str(get(&e, "reason"))) +
+                 "</td><td class=\"n\">" + fmtValue(get(&e, "faces")) + "</td><td class=\"n\">" +
+                 fmtValue(get(&e, "triangles")) + "</td></tr>";
+        o += "</table></div>";
+    } else {
+        o += "<p class=\"note\">" + plural(ndCount, "brush entity", "brush entities") +
+             " the game never draws, none with faces.</p>";
+    }
+    o += "</section>\n";
 }
 
 void HtmlWriter::depthAuditImage() {
@@ -1451,6 +1495,7 @@ std::string reportHtml(const nlohmann::ordered_json &report, const std::string &
     w.header(worstFirst);
     w.summary(worstFirst);
     w.planner();
+    w.quakeMap();
     if (const Json *scene = get(&report, "scene"))
         o += "<section class=\"block\" id=\"scene\"><h2>Scene</h2><details><summary>as loaded</summary>" + genericJson(scene) +
              "</details></section>\n";

@@ -554,11 +554,31 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
                         {"non_solid_triangles", f.nonSolidTriangles},
                         {"unleafed_faces", f.unleafedFaces},
                         {"model_faces", f.modelFaces},
+                        {"brush_entities_drawn", r.bsp->drawnBrushEntities},
+                        {"brush_entities_not_drawn", r.bsp->notDrawnBrushEntities},
+                        {"not_drawn_entity_faces", f.notDrawnEntity},
+                        {"not_drawn_entity_triangles", f.notDrawnEntityTriangles},
                         {"leafs", r.bsp->leafs},
                         {"clusters", r.bsp->clusters},
                         {"patch_level", r.bsp->patchLevel},
                         {"has_pvs", r.bsp->hasPvs},
                         {"spawn_points", r.bsp->spawnPoints}};
+        Json notDrawn = Json::array();
+        for (const auto &e : r.bsp->notDrawn)
+            notDrawn.push_back({{"model", e.model},
+                                {"entity", e.entity},
+                                {"classname", e.classname},
+                                {"reason", e.reason},
+                                {"faces", e.faces},
+                                {"triangles", e.triangles}});
+        scene["bsp"]["not_drawn_entities"] = notDrawn;
+        const BspFarPlane &fp = r.bsp->farPlane;
+        scene["bsp"]["far_plane"] = fp.distance > 0 ? Json{{"distance", fp.distance},
+                                                           {"mode", fp.mode ? std::string(1, fp.mode) : std::string()},
+                                                           {"key", fp.key},
+                                                           {"value", fp.value}}
+                                                     : Json(nullptr);
+        scene["bsp"]["fog_shader"] = r.bsp->fogShader.empty() ? Json(nullptr) : Json(r.bsp->fogShader);
     }
     j["scene"] = scene;
     j["load_ms"] = num(r.loadMs);

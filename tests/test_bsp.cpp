@@ -20,6 +20,7 @@
 #include "analysis/level_views.h"
 #include "analysis/load.h"
 #include "analysis/load_bsp.h"
+#include "analysis/pipeline.h"
 #include "analysis/zip.h"
 
 using namespace va;
@@ -127,7 +128,7 @@ size_t lumpOffset(const std::vector<uint8_t> &f, int l) { return size_t(get32(f,
 //   5 water triangle (leaf 0)                             excluded (non-solid)
 //   6 triangle listed by leaf 0 and leaf 1                owned by leaf 0, clusters {0, 1}
 //   7 triangle no leaf lists (world)                      object "unleafed", no cluster
-//   8 quad of brush model 1 (a door in leaf 0's space)     object "model1", cluster 0 (its box)
+//   8 quad of brush model 1 (a func_door in leaf 0's space) object "model1", cluster 0 (its box)
 // Every face is stored clockwise seen from its front (+z), as Quake 3 stores them.
 BspWriter tinyWriter() {
     BspWriter w;
@@ -137,7 +138,8 @@ BspWriter tinyWriter() {
             "{\n\"classname\" \"info_player_start\"\n\"origin\" \"-50 0 24\"\n\"angles\" \"10 180 0\"\n}\n"
             "// a comment\n"
             "{\n\"classname\" \"info_player_intermission\"\n\"origin\" \"0 0 200\"\n\"target\" \"t1\"\n}\n"
-            "{\n\"classname\" \"target_position\"\n\"targetname\" \"t1\"\n\"origin\" \"50 0 0\"\n}\n",
+            "{\n\"classname\" \"target_position\"\n\"targetname\" \"t1\"\n\"origin\" \"50 0 0\"\n}\n"
+            "{\n\"classname\" \"func_door\"\n\"model\" \"*1\"\n}\n",
             std::string::npos);
     w.lump[LEntities].push_back(0);
     w.shader("textures/base/floor", 0, 1);
@@ -200,6 +202,42 @@ BspWriter tinyWriter() {
     w.i32(LVisData, 2), w.i32(LVisData, 1);
     w.lump[LVisData].push_back(0x1);
     w.lump[LVisData].push_back(0x2);
+    return w;
+}
+
+// A quad facing +z over x0..x1, y0..y1 at height z, stored clockwise seen from +z (as Quake 3).
+void quadFace(BspWriter &w, double x0, double x1, double y0, double y1, double z) {
+    const int32_t v = w.vertex({x0, y1, z});
+    w.vertex({x1, y1, z}), w.vertex({x1, y0, z}), w.vertex({x0, y0, z});
+    w.face(0, 1, v, 4, w.meshverts({0, 1, 2, 0, 2, 3}), 6);
+}
+
+// The tiny map with brush entities laid out as q3map2 writes them: each model's faces are listed
+// only by a leaf of its own (cluster 0, zero bounds) that the world's tree never reaches.
+//   face 9:  model 2, a trigger_teleport (ordinary shader): never drawn
+//   face 10: model 3, a func_bobbing stored around 0 with "origin" "-50 0 40": drawn in leaf 1
+//   face 11: model 4, which no entity spawns: never drawn
+//   face 12: model 5, a func_door over x -30..-20 (leaf 1's side, cluster 1)
+//   leafs 3..7: the models' own leafs, listing faces 8..12
+BspWriter brushEntityWriter() {
+    BspWriter w = tinyWriter();
+    std::string text(w.lump[LEntities].begin(), w.lump[LEntities].end() - 1);  // without the NUL
+    text += "{\n\"classname\" \"trigger_teleport\"\n\"model\" \"*2\"\n\"target\" \"t1\"\n}\n"
+            "{\n\"classname\" \"func_bobbing\"\n\"model\" \"*3\"\n\"origin\" \"-50 0 40\"\n}\n"
+            "{\n\"classname\" \"func_door\"\n\"model\" \"*5\"\n}\n";
+    w.lump[LEntities].clear();
+    w.bytes(LEntities, text, std::string::npos);
+    w.lump[LEntities].push_back(0);
+    quadFace(w, 60, 70, -5, 5, 10);     // face 9
+    quadFace(w, -5, 5, -5, 5, 0);       // face 10
+    quadFace(w, 40, 50, 20, 30, 20);    // face 11
+    quadFace(w, -30, -20, -10, 10, 30); // face 12
+    for (int32_t f : {8, 9, 10, 11, 12}) w.i32(LLeafFaces, f);
+    for (int32_t k = 0; k < 5; ++k) w.leaf(0, {0, 0, 0}, {0, 0, 0}, 8 + k, 1);
+    w.model({60, -5, 10}, {70, 5, 10}, 9, 1);
+    w.model({-5, -5, 0}, {5, 5, 0}, 10, 1);
+    w.model({40, 20, 20}, {50, 30, 20}, 11, 1);
+    w.model({-30, -10, 30}, {-20, 10, 30}, 12, 1);
     return w;
 }
 
@@ -292,10 +330,104 @@ TEST(Bsp, TinyMapObjectsAndCounts) {
     EXPECT_EQ(lv.pvsRowBytes, 1u);
     EXPECT_EQ(lv.leafs.size(), 3u);
     EXPECT_EQ(lv.nodes.size(), 2u);
-    EXPECT_EQ(lv.entities.size(), 5u);
+    EXPECT_EQ(lv.entities.size(), 6u);
+    ASSERT_EQ(lv.models.size(), 2u);
+    EXPECT_EQ(lv.models[1].entity, 5);
+    EXPECT_EQ(lv.models[1].classname, "func_door");
+    EXPECT_TRUE(lv.models[1].drawn);
+    EXPECT_EQ(lv.models[1].boxLeafs, (std::vector<int32_t>{0}));
+    EXPECT_EQ(lv.sourceModel, (std::vector<uint32_t>{0, 0, 1, 0}));
+    // Each triangle's face: leaf0 = faces 0 (2), 2 (50), 6 (1); leaf1 = 1; model1 = 8 (2); unleafed = 7.
+    std::vector<uint32_t> faceOf;
+    for (auto [f, n] : std::vector<std::pair<uint32_t, int>>{{0, 2}, {2, 50}, {6, 1}, {1, 1}, {8, 2}, {7, 1}})
+        faceOf.insert(faceOf.end(), size_t(n), f);
+    EXPECT_EQ(lv.triangleFace, faceOf);
+    EXPECT_EQ(lv.leafInTree, (std::vector<uint8_t>{1, 1, 1}));
+    EXPECT_EQ(lv.faceLeafsBegin, (std::vector<uint32_t>{0, 1, 2, 3, 4, 5, 6, 8, 8, 8}));
+    EXPECT_EQ(lv.faceLeafs, (std::vector<uint32_t>{0, 1, 0, 1, 0, 0, 0, 1}));
+    EXPECT_EQ(lv.farPlane.distance, 0);
     ASSERT_EQ(s.warnings.size(), 1u);
     EXPECT_EQ(s.warnings[0], s.path + ": kept out of the objects (docs/quake3.md): 1 sky, 0 nodraw, "
                                       "1 non-solid see-through, 1 billboard and 0 bad faces");
+}
+
+// Brush entities (issue 15): a model's faces get the clusters of its placed box walked through the
+// world's tree, never the cluster 0 of the model's own leaf; triggers and models no entity spawns are
+// not geometry. Before, face 12 (the door on cluster 1's side) took cluster {0} from leaf 7 and was
+// culled from every view that could see it.
+TEST(Bsp, TinyMapBrushEntities) {
+    const std::string p = writeFile("entities.bsp", brushEntityWriter().file());
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadBspScene(p, {}, {}, &s, &err)) << err;
+    const BspLevel &lv = *s.bsp;
+    ASSERT_EQ(s.sources.size(), 6u);
+    const char *names[] = {"leaf0", "leaf1", "model1", "model3", "model5", "unleafed"};
+    for (size_t k = 0; k < 6; ++k) EXPECT_EQ(s.sources[k].name, names[k]);
+    EXPECT_EQ(lv.sourceModel, (std::vector<uint32_t>{0, 0, 1, 3, 5, 0}));
+    // Clusters: leaf0 {0, 1}, leaf1 {1}, model1 {0}, model3 {1} (placed at x -55..-45), model5 {1}.
+    EXPECT_EQ(lv.sourceClustersBegin, (std::vector<uint32_t>{0, 2, 3, 4, 5, 6, 6}));
+    EXPECT_EQ(lv.sourceClusters, (std::vector<int32_t>{0, 1, 1, 0, 1, 1}));
+    EXPECT_EQ(lv.leafInTree, (std::vector<uint8_t>{1, 1, 1, 0, 0, 0, 0, 0}));
+    ASSERT_EQ(lv.models.size(), 6u);
+    EXPECT_FALSE(lv.models[2].drawn);
+    EXPECT_EQ(lv.models[2].classname, "trigger_teleport");
+    EXPECT_EQ(lv.models[2].entity, 6);
+    EXPECT_EQ(lv.models[2].notDrawnFaces, 1u);
+    EXPECT_EQ(lv.models[2].notDrawnTriangles, 2u);
+    EXPECT_TRUE(lv.models[2].boxLeafs.empty());
+    EXPECT_TRUE(lv.models[3].drawn);
+    EXPECT_EQ(lv.models[3].offset, (Vec3{-50, 0, 40}));
+    EXPECT_EQ(lv.models[3].bounds.lo, (Vec3{-55, -5, 40}));
+    EXPECT_EQ(lv.models[3].boxLeafs, (std::vector<int32_t>{1}));
+    EXPECT_FALSE(lv.models[4].drawn);
+    EXPECT_EQ(lv.models[4].entity, -1);
+    EXPECT_EQ(lv.models[4].notDrawnFaces, 1u);
+    EXPECT_EQ(lv.models[5].boxLeafs, (std::vector<int32_t>{1}));
+    const BspFaceCounts &fc = lv.faceCounts;
+    EXPECT_EQ(fc.faces, 13u);
+    EXPECT_EQ(fc.modelFaces, 3u);
+    EXPECT_EQ(fc.notDrawnEntity, 2u);
+    EXPECT_EQ(fc.notDrawnEntityTriangles, 4u);
+    EXPECT_EQ(fc.polygons, 6u);
+    EXPECT_EQ(fc.polygons + fc.patches + fc.meshes + fc.billboards + fc.bad + fc.sky + fc.nodraw + fc.nonSolid +
+                  fc.notDrawnEntity, fc.faces);
+    EXPECT_EQ(s.triangleCount(), 61u);
+    // model3 is drawn where its entity's origin puts it.
+    const SourceObject &bob = s.sources[3];
+    const SceneObject &bobObj = s.objects[bob.firstChunk];
+    for (uint32_t v = bobObj.vertexBegin; v < bobObj.vertexEnd; ++v) {
+        EXPECT_GE(s.positions[v].x, -55);
+        EXPECT_LE(s.positions[v].x, -45);
+        EXPECT_EQ(s.positions[v].z, 40);
+    }
+    ASSERT_EQ(s.warnings.size(), 2u);
+    EXPECT_EQ(s.warnings[1], p + ": not geometry (docs/quake3.md, \"Brush entities\"): 2 faces of 2 brush entities the "
+                                 "engine never draws (trigger_*, models no entity spawns)");
+    // From cluster 1 (x < 0) the door and the bobbing platform stay; from cluster 0 they are culled.
+    CellsResult r = cullCells(s, cameraAt(s, {-25, 0, 80}));
+    EXPECT_EQ(r.stats.cameraCluster, 1);
+    EXPECT_EQ(r.visible, (std::vector<uint32_t>{0, 1, 3, 4, 5}));
+    r = cullCells(s, cameraAt(s, {50, 0, 59}));
+    EXPECT_EQ(r.stats.cameraCluster, 0);
+    EXPECT_EQ(r.visible, (std::vector<uint32_t>{0, 2, 5}));
+    // Looking down at the door from cluster 1: the reference shows it and the PVS keeps it.
+    Camera cam;
+    ASSERT_TRUE(makeCamera(quakeCamera(s, {-25, 0, 80}, 0, 89), &cam, &err)) << err;
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    uint64_t doorPixels = 0;
+    for (uint32_t t = s.sources[4].firstTriangle; t < s.sources[4].firstTriangle + s.sources[4].triangleCount; ++t)
+        doorPixels += ref.pixelsOf[t];
+    EXPECT_GT(doorPixels, 1000u);
+    r = cullCells(s, cam);
+    std::vector<uint32_t> culled;
+    for (uint32_t o = 0; o < s.objects.size(); ++o)
+        if (!std::binary_search(r.visible.begin(), r.visible.end(), o)) culled.push_back(o);
+    std::vector<uint32_t> all;
+    for (uint32_t t = 0; t < s.triangleCount(); ++t)
+        if (s.triangleObject[t] != kExcludedTriangle) all.push_back(t);
+    const CullAudit a = auditCulling(s, ref, {{"cells", culled, {}}}, all, nullptr);
+    EXPECT_EQ(a.falseCullPixels, 0u);
 }
 
 TEST(Bsp, PatchLevelSetsTriangleCount) {
@@ -352,7 +484,7 @@ TEST(Bsp, LeafLookupWalksTheTree) {
 TEST(Bsp, EntitiesParsed) {
     const Scene s = loadTiny();
     const auto &e = s.bsp->entities;
-    ASSERT_EQ(e.size(), 5u);
+    ASSERT_EQ(e.size(), 6u);
     EXPECT_EQ(*e[1].get("classname"), "info_player_deathmatch");
     EXPECT_EQ(*e[1].get("origin"), "50 0 24");
     EXPECT_EQ(e[1].get("nothing"), nullptr);
@@ -760,7 +892,9 @@ void expectCounts(const Scene &s, const MapCounts &want) {
     std::printf("\n");
     const BspFaceCounts &fc = s.bsp->faceCounts;
     // Every face is counted under exactly one kind, and the drawn faces' triangles are the scene's.
-    EXPECT_EQ(fc.polygons + fc.patches + fc.meshes + fc.billboards + fc.bad + fc.sky + fc.nodraw + fc.nonSolid, fc.faces);
+    EXPECT_EQ(fc.polygons + fc.patches + fc.meshes + fc.billboards + fc.bad + fc.sky + fc.nodraw + fc.nonSolid +
+                  fc.notDrawnEntity,
+              fc.faces);
     EXPECT_EQ(fc.polygonTriangles + fc.patchTriangles + fc.meshTriangles, s.triangleCount());
 }
 
@@ -834,8 +968,22 @@ TEST(Bsp, RealOaThor) {
     REQUIRE_OA("pak6-patch088.pk3");
     const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
     // 170 player spawns (58 info_player_start, 2 x 17 team_CTF_*player, 2 x 39 team_CTF_*spawn) and 1
-    // intermission; 1292 non-solid faces (light beams), 6 sky faces; patches at level 5.
-    expectCounts(s, {43185, 205, 2297, 2269, 2825, 5373, 11211, 9831, 82, 0, 0, 6, 0, 1292, 26785, 16400, 0, 171});
+    // intermission; 1292 non-solid faces (light beams), 6 sky faces; patches at level 5. Face 11210
+    // (2 triangles, an ordinary texture) is model 5, a trigger_push: not geometry (it was, before
+    // issue 15: 43185 triangles, 2297 objects, 9831 polygons).
+    expectCounts(s, {43183, 205, 2296, 2268, 2825, 5373, 11211, 9830, 82, 0, 0, 6, 0, 1292, 26783, 16400, 0, 171});
+    const BspLevel &lv = *s.bsp;
+    EXPECT_EQ(lv.faceCounts.notDrawnEntity, 1u);
+    EXPECT_EQ(lv.faceCounts.notDrawnEntityTriangles, 2u);
+    EXPECT_EQ(lv.faceCounts.modelFaces, 0u);
+    ASSERT_EQ(lv.models.size(), 17u);
+    for (size_t k = 1; k < lv.models.size(); ++k) {
+        EXPECT_FALSE(lv.models[k].drawn) << k;  // all 16 brush entities are triggers
+        EXPECT_EQ(lv.models[k].classname.rfind("trigger_", 0), 0u) << k;
+    }
+    EXPECT_EQ(lv.models[5].classname, "trigger_push");
+    EXPECT_EQ(lv.models[5].firstFace, 11210u);
+    EXPECT_EQ(lv.models[5].notDrawnFaces, 1u);
     EXPECT_EQ(s.bsp->pvsRowBytes, 360u);
     EXPECT_EQ(s.bsp->nodes.size(), 5355u);
     // The same map read loose (written out of the archive) gives the same scene.
@@ -844,6 +992,149 @@ TEST(Bsp, RealOaThor) {
     EXPECT_EQ(loose.triangleCount(), s.triangleCount());
     EXPECT_EQ(loose.positions, s.positions);
     EXPECT_EQ(loose.bsp->pvs, s.bsp->pvs);
+}
+
+// Brush entities on real maps (issue 15). The leafs a model's box reaches are checked against an
+// independent enumeration: a leaf is reached when, on its path from the root, the widened box lies
+// (at least partly) on the side of each node's plane that the path takes.
+namespace {
+std::vector<int32_t> leafsByPaths(const BspLevel &lv, const Aabb &box) {
+    std::vector<int32_t> out;
+    struct Step {
+        int32_t node;
+        bool ok;
+    };
+    std::vector<Step> todo{{0, true}};
+    while (!todo.empty()) {
+        const Step st = todo.back();
+        todo.pop_back();
+        if (st.node < 0) {
+            if (st.ok) out.push_back(-(st.node + 1));
+            continue;
+        }
+        const BspNode &n = lv.nodes[size_t(st.node)];
+        const BspPlane &pl = lv.planes[n.plane];
+        // The box's corner farthest along the normal and the one farthest against it.
+        Vec3 far, near;
+        for (int a = 0; a < 3; ++a) {
+            far[a] = pl.normal[a] >= 0 ? box.hi[a] : box.lo[a];
+            near[a] = pl.normal[a] >= 0 ? box.lo[a] : box.hi[a];
+        }
+        todo.push_back({n.children[0], st.ok && dot(pl.normal, far) - pl.dist >= 0});
+        todo.push_back({n.children[1], st.ok && dot(pl.normal, near) - pl.dist < 0});
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+}  // namespace
+
+TEST(Bsp, RealBrushEntityClusters) {
+    REQUIRE_OA("pak1-maps.pk3");
+    REQUIRE_OA("pak6-patch088.pk3");
+    struct Want {
+        std::string path;
+        uint64_t modelFaces, notDrawn, modelObjects;
+    };
+    // oa_dm1: 4 func_door + 2 func_button (6 faces each), a trigger_teleport and a trigger_hurt
+    // without faces; q3dm6ish: 6 func_illusionary, 3 trigger_push; cbctf1: a func_bobbing placed by
+    // its "origin" and 14 trigger_push, 4 trigger_teleport, a trigger_hurt (no faces).
+    for (const Want &w : std::vector<Want>{{"pak1-maps.pk3:maps/oa_dm1.bsp", 36, 0, 6},
+                                           {"pak1-maps.pk3:maps/q3dm6ish.bsp", 36, 0, 6},
+                                           {"pak6-patch088.pk3:maps/cbctf1.bsp", 26, 0, 1}}) {
+        const Scene s = loadReal(kOa + w.path);
+        const BspLevel &lv = *s.bsp;
+        EXPECT_EQ(lv.faceCounts.modelFaces, w.modelFaces) << w.path;
+        EXPECT_EQ(lv.faceCounts.notDrawnEntity, w.notDrawn) << w.path;
+        uint64_t modelObjects = 0;
+        for (size_t src = 0; src < s.sources.size(); ++src) {
+            const uint32_t k = lv.sourceModel[src];
+            if (k == 0) continue;
+            ++modelObjects;
+            const BspModel &m = lv.models[k];
+            ASSERT_TRUE(m.drawn) << w.path << " model " << k;
+            EXPECT_EQ(s.sources[src].name, "model" + std::to_string(k));
+            EXPECT_EQ(m.boxLeafs, leafsByPaths(lv, {m.bounds.lo - Vec3{1, 1, 1}, m.bounds.hi + Vec3{1, 1, 1}}))
+                << w.path << " model " << k;
+            // The object's clusters are its box leafs' (never the model's own leaf's cluster 0).
+            std::set<int32_t> want;
+            for (int32_t l : m.boxLeafs)
+                if (lv.leafs[size_t(l)].cluster >= 0) want.insert(lv.leafs[size_t(l)].cluster);
+            const std::set<int32_t> got(lv.sourceClusters.begin() + lv.sourceClustersBegin[src],
+                                        lv.sourceClusters.begin() + lv.sourceClustersBegin[src + 1]);
+            EXPECT_EQ(got, want) << w.path << " model " << k;
+            EXPECT_FALSE(want.empty()) << w.path << " model " << k;
+            const int32_t centerLeaf = lv.leafAt(m.bounds.center());
+            if (lv.leafs[size_t(centerLeaf)].cluster >= 0)
+                EXPECT_TRUE(want.count(lv.leafs[size_t(centerLeaf)].cluster)) << w.path << " model " << k;
+        }
+        EXPECT_EQ(modelObjects, w.modelObjects) << w.path;
+    }
+    // cbctf1's func_bobbing (model 19) is stored around 0 and drawn at its "origin".
+    const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/cbctf1.bsp");
+    const BspModel &bob = s.bsp->models[19];
+    EXPECT_EQ(bob.classname, "func_bobbing");
+    EXPECT_EQ(bob.offset, (Vec3{3488, 0, 1749.5}));
+    const SourceObject *o = sourceNamed(s, "model19");
+    ASSERT_NE(o, nullptr);
+    const SceneObject &ob = s.objects[o->firstChunk];
+    EXPECT_TRUE(ob.bounds.lo.x >= bob.bounds.lo.x && ob.bounds.hi.x <= bob.bounds.hi.x) << ob.bounds.lo.x;
+    EXPECT_GT(ob.bounds.lo.x, 3000);
+}
+
+// Trigger volumes drawn with ordinary textures are not geometry (issue 15): pak1's czest2ctf has 42
+// such faces (84 triangles) in its trigger_push / trigger_teleport / trigger_hurt / trigger_multiple
+// brushes; before, they were objects, and from the spawn points the PVS culled 16,309 of their
+// pixels at 160x90 (the report's false culls).
+TEST(Bsp, RealTriggerVolumesAreNotGeometry) {
+    REQUIRE_OA("pak1-maps.pk3");
+    const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/czest2ctf.bsp");
+    const BspLevel &lv = *s.bsp;
+    EXPECT_EQ(lv.faceCounts.notDrawnEntity, 42u);
+    EXPECT_EQ(lv.faceCounts.notDrawnEntityTriangles, 84u);
+    EXPECT_EQ(lv.faceCounts.modelFaces, 20u);  // two func_plat, 10 faces each
+    uint64_t faces = 0, triggers = 0;
+    for (size_t k = 1; k < lv.models.size(); ++k) {
+        const BspModel &m = lv.models[k];
+        EXPECT_EQ(m.drawn, m.classname.rfind("trigger_", 0) != 0) << k;
+        if (!m.drawn) ++triggers, faces += m.notDrawnFaces;
+    }
+    EXPECT_EQ(triggers, 7u);
+    EXPECT_EQ(faces, 42u);
+    for (const SourceObject &o : s.sources)
+        for (size_t k = 1; k < lv.models.size(); ++k)
+            if (!lv.models[k].drawn) EXPECT_NE(o.name, "model" + std::to_string(k));
+    // No triangle comes from a trigger's face.
+    for (uint32_t f : lv.triangleFace)
+        for (size_t k = 1; k < lv.models.size(); ++k)
+            if (!lv.models[k].drawn)
+                ASSERT_FALSE(f >= lv.models[k].firstFace && f < lv.models[k].firstFace + lv.models[k].faceCount);
+}
+
+// The whole pipeline from every spawn point of maps with doors, movers and trigger volumes (issue
+// 15), at 160x90: no false cull is left. Before, the brush models' faces sat in cluster 0 and the
+// triggers' faces were geometry: q3dm6ish had 16 false-cull pixels, oa_dm1 144, pak1's czest2ctf
+// 16,309 -- all of them counted a second time as "genuine" z-buffer/ray-cast disagreements.
+TEST(Audit, RealMapsBrushEntitiesLeaveNoFalseCulls) {
+    REQUIRE_OA("pak1-maps.pk3");
+    for (const char *path : {"pak1-maps.pk3:maps/q3dm6ish.bsp", "pak1-maps.pk3:maps/oa_dm1.bsp",
+                             "pak1-maps.pk3:maps/czest2ctf.bsp"}) {
+        const Scene s = loadReal(kOa + path);
+        PipelineSettings ps;
+        ps.width = 160, ps.height = 90;
+        ps.ordering = false, ps.zfight = false, ps.detail = false, ps.occlusion = false;
+        AnalysisResult out;
+        std::string err;
+        ASSERT_TRUE(analyzeScene(s, s.views, ps, nullptr, &out, &err)) << err;
+        uint64_t falsePixels = 0, cellsCulled = 0;
+        for (const ViewResult &v : out.views) {
+            falsePixels += v.cullAudit.falseCullPixels;
+            cellsCulled += v.cells.objectsCulled;
+        }
+        std::printf("  %s: %zu views, PVS culled %llu objects, false-cull pixels %llu\n", path, out.views.size(),
+                    (unsigned long long)cellsCulled, (unsigned long long)falsePixels);
+        EXPECT_GT(cellsCulled, 0u) << path;
+        EXPECT_EQ(falsePixels, 0u) << path;
+    }
 }
 
 // Quake 3's winding, checked against the map's own normals: each polygon face stores its plane's
@@ -898,10 +1189,14 @@ TEST(Bsp, RealWindingAgreesWithStoredNormals) {
             continue;
         }
         if (type != 1) continue;
-        // Drawn, by docs/quake3.md's rule: not sky, nodraw/hint/skip, liquid, fog or non-solid translucent.
+        // Drawn, by docs/quake3.md's rule: not sky, nodraw/hint/skip, area portal, liquid, fog or non-solid
+        // translucent; and a world face (model 0's range): oa_thor's 16 brush entities are all triggers.
         const size_t sh = lumpOffset(f, LShaders) + 72 * size_t(get32(f, r));
         const uint32_t flags = uint32_t(get32(f, sh + 64)), contents = uint32_t(get32(f, sh + 68));
-        const bool drawn = !(flags & 0x384) && !(contents & 0x78) && !((flags & 0x4000) && (contents & 0x20000000));
+        const size_t model0 = lumpOffset(f, LModels);
+        const bool world = int32_t(i) >= get32(f, model0 + 24) && int32_t(i) < get32(f, model0 + 24) + get32(f, model0 + 28);
+        const bool drawn = world && !(flags & 0x384) && !(contents & 0x8078) &&
+                           !((flags & 0x4000) && (contents & 0x20000000));
         const Vec3 faceNormal{fl(r + 84), fl(r + 88), fl(r + 92)};
         for (int32_t k = 0; k < nm; k += 3) {
             const Vec3 a = pos(v0 + get32(f, mv + 4 * size_t(m0 + k))), b = pos(v0 + get32(f, mv + 4 * size_t(m0 + k + 1))),
@@ -1001,9 +1296,11 @@ TEST(Cells, RealMapsFirstSpawnExactCounts) {
         uint64_t clustersVisible, clustersTotal, objectsCulled, objectsIn, trianglesCulled, trianglesIn;
     };
     for (const Want &w : std::vector<Want>{
-             {"pak1-maps.pk3:maps/q3dm6ish.bsp", 238, 97, 176, 247, 53, 231, 404, 2621},
-             {"pak1-maps.pk3:maps/oa_dm1.bsp", 327, 120, 90, 422, 151, 241, 3215, 7422},
-             {"pak6-patch088.pk3:maps/oa_thor.bsp", 4828, 2539, 1191, 2825, 1166, 2297, 18980, 42980}}) {
+             // Before issue 15 the brush models took cluster 0 from their own leafs: q3dm6ish culled
+             // 53 objects / 404 triangles, oa_dm1 151 / 3215 (three doors and buttons falsely).
+             {"pak1-maps.pk3:maps/q3dm6ish.bsp", 238, 97, 176, 247, 55, 231, 428, 2621},
+             {"pak1-maps.pk3:maps/oa_dm1.bsp", 327, 120, 90, 422, 148, 241, 3179, 7422},
+             {"pak6-patch088.pk3:maps/oa_thor.bsp", 4828, 2539, 1191, 2825, 1166, 2296, 18980, 42978}}) {
         const Scene s = loadReal(kOa + w.path);
         ASSERT_GT(s.views.size(), 0u);
         Camera cam;
