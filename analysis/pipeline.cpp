@@ -141,7 +141,11 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             }
             st.ms = t0.ms();
             st.ran = true;
-            if (s.audit) culls.push_back({"cells", removed(objects, visible), {}});
+            if (s.audit) {
+                culls.push_back({"cells", removed(objects, visible), {}});
+                // A map's PVS leaves out on purpose what lies beyond its designed far plane.
+                if (!hasPortals && scene.bsp) culls.back().designFarPlane = scene.bsp->farPlane.distance;
+            }
             objects = std::move(visible);
             st.trianglesOut = trianglesOf(scene, objects);
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;
@@ -321,7 +325,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     if (s.audit) {
         const Stopwatch t0;
         r.reference = referenceVisibility(scene, cam);
-        r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource);
+        r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource, &cam);
         r.auditMs = t0.ms();
         r.auditRan = true;
     } else {

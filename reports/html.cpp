@@ -1290,6 +1290,18 @@ void HtmlWriter::falseCulls(const Json *v, const std::string &id, const std::vec
             o += "<p class=\"note\">Not counted above: " + plural(snappedTris, "back-facing sliver", "back-facing slivers") +
                  " (" + plural(snappedPx, "pixel", "pixels") + ") culled rightly by the backface stage: the reference "
                  "sees a front winding only because snapping to the 1/256-pixel grid flipped it.</p>";
+        for (auto it = byStage->begin(); it != byStage->end(); ++it) {
+            const Json *st = &it.value();
+            const double bpx = numOr(st, {"beyond_far_plane_pixels"}, 0);
+            if (bpx <= 0) continue;
+            o += "<p class=\"note\" id=\"" + id + "-beyond\">Not counted above: " + plural(bpx, "pixel", "pixels") +
+                 " of surfaces the " + esc(it.key()) + " stage left out lie beyond the map's far plane (" +
+                 fmtReal(numOr(st, {"design_far_plane"}, 0)) + " units; the nearest " +
+                 fmtReal(numOr(st, {"beyond_far_plane_nearest"}, 0)) +
+                 " units from the eye): hidden by design, as the compiler's distance rule leaves them out (" +
+                 plural(numOr(st, {"beyond_far_plane_triangles"}, 0), "triangle", "triangles") +
+                 " visible only there).</p>";
+        }
     }
     if (const Json *w = get(a, "wasted_draws"); w && w->is_object())
         o += "<p>Wasted draws: " + fmtCount(numOr(w, {"triangles"}, 0)) + " of " + fmtCount(numOr(w, {"drawn_triangles"}, 0)) +

@@ -435,14 +435,22 @@ Json auditJson(const ViewResult &v) {
                             {"false_cull_triangles", s.falseCullTriangles},
                             {"false_cull_objects", s.falseCullObjects},
                             {"false_cull_pixels", s.falseCullPixels},
+                            {"false_cull_nearest", s.falseCullPixels ? num(s.falseCullNearest) : Json(nullptr)},
                             {"snapped_triangles", s.snappedTriangles},
                             {"snapped_pixels", s.snappedPixels},
+                            {"design_far_plane", s.designFarPlane > 0 ? num(s.designFarPlane) : Json(nullptr)},
+                            {"beyond_far_plane_triangles", s.beyondFarPlaneTriangles},
+                            {"beyond_far_plane_pixels", s.beyondFarPlanePixels},
+                            {"beyond_far_plane_nearest",
+                             s.beyondFarPlanePixels ? num(s.beyondFarPlaneNearest) : Json(nullptr)},
                             {"worst", worst}};
         falseObjects += s.falseCullObjects;
     }
     j["false_culls"] = {{"triangles", a.falseCullTriangles},
                         {"objects", falseObjects},
                         {"pixels", a.falseCullPixels},
+                        {"beyond_far_plane_triangles", a.beyondFarPlaneTriangles},
+                        {"beyond_far_plane_pixels", a.beyondFarPlanePixels},
                         {"by_stage", byStage}};
     j["wasted_draws"] = {{"drawn_triangles", a.drawnTriangles},
                          {"drawn_objects", a.drawnObjects},
@@ -696,7 +704,8 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     std::vector<std::string> stageOrder;
     std::map<std::string, uint64_t> culled;
     uint64_t covered = 0, fragments = 0, passes = 0;
-    uint64_t falseTris = 0, falsePixels = 0, wastedTris = 0, wastedFragments = 0, genuine = 0, hotspots = 0;
+    uint64_t falseTris = 0, falsePixels = 0, beyondPixels = 0, wastedTris = 0, wastedFragments = 0, genuine = 0,
+             hotspots = 0;
     std::map<std::string, uint64_t> falseByStage;
     double totalMs = 0;
     // A count of a section that may be absent (a stage or audit that did not run) reads as 0.
@@ -711,6 +720,7 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     for (const Json &v : views) {
         falseTris += count(v, {"audit", "false_culls", "triangles"});
         falsePixels += count(v, {"audit", "false_culls", "pixels"});
+        beyondPixels += count(v, {"audit", "false_culls", "beyond_far_plane_pixels"});
         if (v.contains("audit") && v["audit"].contains("false_culls"))
             for (const auto &[stage, st] : v["audit"]["false_culls"]["by_stage"].items())
                 falseByStage[stage] += count(st, {"false_cull_triangles"});
@@ -742,6 +752,7 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     totals["false_cull_triangles"] = falseTris;
     totals["false_cull_pixels"] = falsePixels;
     totals["false_cull_triangles_by_stage"] = falseStages;
+    totals["beyond_far_plane_pixels"] = beyondPixels;
     totals["wasted_triangles"] = wastedTris;
     totals["wasted_fragments"] = wastedFragments;
     totals["genuine_disagreements"] = genuine;

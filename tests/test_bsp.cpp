@@ -824,6 +824,124 @@ TEST(LevelViews, WalkIsSeededAndInsideClusters) {
     EXPECT_TRUE(differs);
 }
 
+// ---- The designed far plane (issue 15) ------------------------------------------------------------
+
+namespace {
+// The tiny map with its worldspawn's keys replaced.
+Scene tinyWithWorldspawn(const std::string &keys) {
+    BspWriter w = tinyWriter();
+    std::string text(w.lump[LEntities].begin(), w.lump[LEntities].end() - 1);
+    const std::string ws = "{\n\"classname\" \"worldspawn\"\n}\n";
+    text.replace(text.find(ws), ws.size(), "{\n\"classname\" \"worldspawn\"\n" + keys + "}\n");
+    w.lump[LEntities].clear();
+    w.bytes(LEntities, text, std::string::npos);
+    w.lump[LEntities].push_back(0);
+    const std::string p = writeFile("farplane.bsp", w.file());
+    Scene s;
+    std::string err;
+    EXPECT_TRUE(loadBspScene(p, {}, {}, &s, &err)) << err;
+    return s;
+}
+}  // namespace
+
+TEST(LevelViews, FarPlaneKeysAsQ3map2ReadsThem) {
+    Scene s = tinyWithWorldspawn("\"_farplanedist\" \"150\"\n");
+    EXPECT_EQ(s.bsp->farPlane.distance, 150);
+    EXPECT_EQ(s.bsp->farPlane.key, "_farplanedist");
+    EXPECT_EQ(s.bsp->farPlane.mode, 0);
+    // The map's views use it as their far plane (the map's diagonal + 16 would be 225).
+    ASSERT_FALSE(s.views.empty());
+    EXPECT_EQ(s.views[0].camera.farZ, 150);
+    EXPECT_EQ(quakeCamera(s, {50, 0, 40}, 0).farZ, 150);
+    s = tinyWithWorldspawn("\"_farplanedist\" \"512o\"\n\"_fog\" \"textures/fog/murk\"\n");
+    EXPECT_EQ(s.bsp->farPlane.distance, 512);
+    EXPECT_EQ(s.bsp->farPlane.mode, 'o');
+    EXPECT_EQ(s.bsp->fogShader, "textures/fog/murk");
+    EXPECT_EQ(s.views[0].camera.farZ, 225);  // farther than the map: the diagonal's far plane stays
+    s = tinyWithWorldspawn("\"fogclip\" \"96\"\n");
+    EXPECT_EQ(s.bsp->farPlane.distance, 96);
+    EXPECT_EQ(s.bsp->farPlane.key, "fogclip");
+    // "_farplanedist" wins over the other games' keys; a value that is no positive number is none.
+    s = tinyWithWorldspawn("\"distancecull\" \"64\"\n\"_farplanedist\" \"128\"\n");
+    EXPECT_EQ(s.bsp->farPlane.distance, 128);
+    s = tinyWithWorldspawn("\"_farplanedist\" \"-5\"\n");
+    EXPECT_EQ(s.bsp->farPlane.distance, 0);
+    s = tinyWithWorldspawn("\"_farplanedist\" \"far\"\n");
+    EXPECT_EQ(s.bsp->farPlane.distance, 0);
+    EXPECT_EQ(s.views[0].camera.farZ, 225);
+}
+
+// From cluster 0, looking at leaf 1's triangle (cluster 1, which cluster 0 cannot see): every pixel
+// of it is culled by the PVS. With a design far plane, the pixels whose point lies farther than it
+// from the eye are hidden by design, the others stay false culls.
+TEST(Audit, DesignFarPlaneSplitsTheCulledPixels) {
+    const Scene s = loadTiny();
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(quakeCamera(s, {50, 0, 59}, 180, 30), &cam, &err)) << err;
+    const ReferenceVisibility ref = referenceVisibility(s, cam);
+    const CellsResult r = cullCells(s, cam);
+    ASSERT_EQ(r.stats.cameraCluster, 0);
+    std::vector<uint32_t> culled;
+    for (uint32_t o = 0; o < s.objects.size(); ++o)
+        if (!std::binary_search(r.visible.begin(), r.visible.end(), o)) culled.push_back(o);
+    ASSERT_EQ(culled, (std::vector<uint32_t>{1}));  // leaf1
+    std::vector<uint32_t> drawn;
+    for (uint32_t t = 0; t < s.triangleCount(); ++t)
+        if (s.triangleObject[t] != kExcludedTriangle && s.triangleObject[t] != 1) drawn.push_back(t);
+    const uint32_t leaf1Tri = s.sources[1].firstTriangle;
+    const uint64_t visible = ref.pixelsOf[leaf1Tri];
+    ASSERT_GT(visible, 1000u);
+    // The distances of its pixels, straight from the camera: pixel center ray times the depth.
+    double nearest = 1e300, farthest = 0;
+    for (size_t i = 0; i < ref.id.size(); ++i)
+        if (ref.id[i] == leaf1Tri + 1) {
+            const double d = pixelPointDistance(cam, i, ref.depth[i]);
+            nearest = std::min(nearest, d), farthest = std::max(farthest, d);
+        }
+    const double limit = (nearest + farthest) / 2;
+    for (double fp : {0.0, limit, nearest / 2, farthest * 2}) {
+        StageCulls st{"cells", culled, {}};
+        st.designFarPlane = fp;
+        const CullAudit a = auditCulling(s, ref, {st}, drawn, nullptr, &cam);
+        const StageCullAudit &c = a.stages[0];
+        uint64_t beyondFate = 0, falseFate = 0, beyondCount = 0;
+        for (size_t i = 0; i < ref.id.size(); ++i) {
+            beyondFate += a.fate[i] == kFateBeyondFarPlane;
+            falseFate += a.fate[i] == kFateCulledFirst;
+            if (ref.id[i] == leaf1Tri + 1 && fp > 0) beyondCount += pixelPointDistance(cam, i, ref.depth[i]) > fp;
+        }
+        EXPECT_EQ(c.beyondFarPlanePixels, beyondCount) << fp;
+        EXPECT_EQ(c.falseCullPixels + c.beyondFarPlanePixels, visible) << fp;
+        EXPECT_EQ(beyondFate, c.beyondFarPlanePixels) << fp;
+        EXPECT_EQ(falseFate, c.falseCullPixels) << fp;
+        EXPECT_EQ(a.beyondFarPlanePixels, c.beyondFarPlanePixels);
+        EXPECT_EQ(c.designFarPlane, fp);
+        if (fp == 0 || fp >= farthest) {  // none, or farther than all of it: all false culls
+            EXPECT_EQ(c.falseCullPixels, visible);
+            EXPECT_EQ(c.falseCullTriangles, 1u);
+            EXPECT_EQ(c.falseCullNearest, nearest);
+        } else if (fp < nearest) {  // all beyond: hidden by design, no false cull
+            EXPECT_EQ(c.falseCullPixels, 0u);
+            EXPECT_EQ(c.falseCullTriangles, 0u);
+            EXPECT_EQ(c.beyondFarPlaneTriangles, 1u);
+            EXPECT_EQ(c.beyondFarPlaneNearest, nearest);
+            EXPECT_TRUE(c.worst.empty());
+        } else {  // split: the triangle is still a false cull, at its near pixels only
+            EXPECT_GT(c.falseCullPixels, 0u);
+            EXPECT_GT(c.beyondFarPlanePixels, 0u);
+            EXPECT_EQ(c.falseCullTriangles, 1u);
+            EXPECT_EQ(c.beyondFarPlaneTriangles, 0u);
+            EXPECT_EQ(c.falseCullNearest, nearest);
+            EXPECT_GT(c.beyondFarPlaneNearest, fp);
+        }
+    }
+    // Without a camera there are no distances: the far plane is not applied.
+    StageCulls st{"cells", culled, {}};
+    st.designFarPlane = nearest / 2;
+    EXPECT_EQ(auditCulling(s, ref, {st}, drawn, nullptr).stages[0].falseCullPixels, visible);
+}
+
 TEST(LevelViews, ViewsOptionValues) {
     const Scene s = loadTiny();
     std::vector<ViewSpec> v;
@@ -1135,6 +1253,72 @@ TEST(Audit, RealMapsBrushEntitiesLeaveNoFalseCulls) {
         EXPECT_GT(cellsCulled, 0u) << path;
         EXPECT_EQ(falsePixels, 0u) << path;
     }
+}
+
+// Real maps with a designed far plane (issue 15): pak6's czest2ctf ("_farplanedist" "4096") and
+// pak1's ctf_compromise ("2048", with a "_foghull"). The spawn views use it as their far plane; with
+// the far plane the views had before (the map's diagonal: 25,297 and 7,317 units), the PVS's
+// omissions are all beyond it -- hidden by design, not the false culls they were reported as.
+TEST(Audit, RealMapsFarPlaneHiddenByDesign) {
+    REQUIRE_OA("pak1-maps.pk3");
+    REQUIRE_OA("pak6-patch088.pk3");
+    struct Want {
+        std::string path;
+        double farPlane, oldFar;
+        uint64_t beyondPixels;
+    };
+    // At 160x90 from every spawn point: 5 and 6 pixels, all farther than the far plane from the eye.
+    for (const Want &w : std::vector<Want>{{"pak6-patch088.pk3:maps/czest2ctf.bsp", 4096, 25297, 5},
+                                           {"pak1-maps.pk3:maps/ctf_compromise.bsp", 2048, 7317, 6}}) {
+        const Scene s = loadReal(kOa + w.path);
+        EXPECT_EQ(s.bsp->farPlane.distance, w.farPlane) << w.path;
+        EXPECT_EQ(s.bsp->farPlane.key, "_farplanedist");
+        ASSERT_FALSE(s.views.empty());
+        uint64_t falseDesign = 0, beyondDesign = 0, falseOld = 0, beyondOld = 0, falseNoPlane = 0;
+        double nearestBeyond = 0;
+        for (const ViewSpec &v0 : s.views) {
+            EXPECT_EQ(v0.camera.farZ, w.farPlane) << w.path << " " << v0.name;
+            for (double far : {w.farPlane, w.oldFar}) {
+                CameraSpec spec = v0.camera;
+                spec.width = 160, spec.height = 90, spec.farZ = far;
+                Camera cam;
+                std::string err;
+                ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+                const ReferenceVisibility ref = referenceVisibility(s, cam);
+                const CellsResult r = cullCells(s, cam);
+                std::vector<uint32_t> culled;
+                for (uint32_t o = 0; o < s.objects.size(); ++o)
+                    if (!std::binary_search(r.visible.begin(), r.visible.end(), o)) culled.push_back(o);
+                StageCulls st{"cells", culled, {}};
+                st.designFarPlane = s.bsp->farPlane.distance;
+                const CullAudit a = auditCulling(s, ref, {st}, {}, nullptr, &cam);
+                (far == w.farPlane ? falseDesign : falseOld) += a.falseCullPixels;
+                (far == w.farPlane ? beyondDesign : beyondOld) += a.beyondFarPlanePixels;
+                if (a.beyondFarPlanePixels) {
+                    EXPECT_GT(a.stages[0].beyondFarPlaneNearest, w.farPlane);
+                    if (nearestBeyond == 0 || a.stages[0].beyondFarPlaneNearest < nearestBeyond)
+                        nearestBeyond = a.stages[0].beyondFarPlaneNearest;
+                }
+                if (far == w.oldFar) {
+                    st.designFarPlane = 0;  // what the audit said before: every such pixel a false cull
+                    falseNoPlane += auditCulling(s, ref, {st}, {}, nullptr, &cam).falseCullPixels;
+                }
+            }
+        }
+        std::printf("  %s: far plane %g: false %llu, beyond %llu; far %g: false %llu, beyond %llu (nearest %.1f), "
+                    "without the rule %llu false\n",
+                    w.path.c_str(), w.farPlane, (unsigned long long)falseDesign, (unsigned long long)beyondDesign,
+                    w.oldFar, (unsigned long long)falseOld, (unsigned long long)beyondOld, nearestBeyond,
+                    (unsigned long long)falseNoPlane);
+        EXPECT_EQ(falseDesign, 0u) << w.path;
+        EXPECT_EQ(falseOld, 0u) << w.path;
+        EXPECT_EQ(beyondOld, w.beyondPixels) << w.path;
+        EXPECT_EQ(falseNoPlane, beyondOld) << w.path;
+    }
+    // A map without one keeps the diagonal's far plane.
+    const Scene thor = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
+    EXPECT_EQ(thor.bsp->farPlane.distance, 0);
+    EXPECT_EQ(thor.views[0].camera.farZ, 6915);
 }
 
 // Quake 3's winding, checked against the map's own normals: each polygon face stores its plane's

@@ -454,6 +454,7 @@ TEST(ReportJson, EmptyResult) {
     EXPECT_EQ(j["totals"].dump(),
               R"({"views":0,"triangles_culled":{},"covered_pixels":0,"fragments":0,"depth_passes":0,)"
               R"("false_cull_triangles":0,"false_cull_pixels":0,"false_cull_triangles_by_stage":{},)"
+              R"("beyond_far_plane_pixels":0,)"
               R"("wasted_triangles":0,"wasted_fragments":0,"genuine_disagreements":0,"zfight_hotspots":0,"total_ms":0.0})");
     EXPECT_TRUE(validateReport(loadSchema(), j).empty());
 }
