@@ -326,6 +326,11 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         const Stopwatch t0;
         r.reference = referenceVisibility(scene, cam);
         r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource, &cam);
+        // A map's PVS: the evidence of each false cull it made (camera leaf and cluster, faces, leafs,
+        // clusters, PVS bits, distances), for a reader to check against the map's bytes.
+        if (hasPvs && !hasPortals && s.cells)
+            for (size_t k = 0; k < culls.size(); ++k)
+                if (culls[k].stage == "cells") r.pvsEvidence = pvsEvidence(scene, cam, r.cells, r.reference, r.cullAudit, k);
         r.auditMs = t0.ms();
         r.auditRan = true;
     } else {

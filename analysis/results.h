@@ -15,6 +15,7 @@
 #include "analysis/occlusion.h"
 #include "analysis/ordering.h"
 #include "analysis/portals.h"
+#include "analysis/pvs_evidence.h"
 #include "analysis/effects_plan.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
@@ -89,6 +90,7 @@ struct ViewResult {
     std::string auditReason;          // why it did not run
     ReferenceVisibility reference;
     CullAudit cullAudit;
+    PvsEvidence pvsEvidence;          // a map's PVS: the evidence of its false culls (pvs_evidence.h)
     double auditMs = 0;
     bool zfightRan = false;           // the per-view z-fighting analysis (docs/zfighting.md)
     std::string zfightReason;         // why it did not run

@@ -412,6 +412,57 @@ Json cameraJson(const CameraSpec &c) {
     return j;
 }
 
+// The evidence of a map's PVS false culls (analysis/pvs_evidence.h; docs/quake3.md, "Reading the
+// evidence"). Bounded by the kEvidence* limits; every list says what it left out.
+Json pvsEvidenceJson(const PvsEvidence &e) {
+    auto leafs = [](const std::vector<PvsLeafBit> &ls) {
+        Json a = Json::array();
+        for (const PvsLeafBit &l : ls)
+            a.push_back({{"leaf", l.leaf},
+                         {"cluster", l.cluster},
+                         {"in_tree", l.inTree},
+                         {"pvs_bit", l.pvsBit < 0 ? Json(nullptr) : Json(l.pvsBit)}});
+        return a;
+    };
+    Json objects = Json::array();
+    for (const PvsObjectEvidence &o : e.objects) {
+        Json clusters = Json::array();
+        for (const PvsClusterBit &c : o.clusters) clusters.push_back({{"cluster", c.cluster}, {"pvs_bit", c.pvsBit}});
+        Json faces = Json::array();
+        for (const PvsFaceEvidence &f : o.faces)
+            faces.push_back({{"face", f.face},
+                             {"pixels", f.pixels},
+                             {"nearest", num(f.nearest)},
+                             {"pixel", {f.x, f.y}},
+                             {"leafs", leafs(f.leafs)},
+                             {"leafs_omitted", f.leafsOmitted}});
+        Json oj = {{"object", o.object},
+                   {"name", o.name},
+                   {"model", o.model},
+                   {"entity", o.entity},
+                   {"classname", o.classname},
+                   {"triangles", o.triangles},
+                   {"pixels", o.pixels},
+                   {"nearest", num(o.nearest)},
+                   {"clusters", clusters},
+                   {"clusters_omitted", o.clustersOmitted}};
+        if (o.model > 0) {
+            oj["box_leafs"] = leafs(o.boxLeafs);
+            oj["box_leafs_omitted"] = o.boxLeafsOmitted;
+        }
+        oj["faces"] = faces;
+        oj["faces_omitted"] = o.facesOmitted;
+        objects.push_back(oj);
+    }
+    return {{"camera_leaf", e.cameraLeaf},
+            {"camera_cluster", e.cameraCluster},
+            {"design_far_plane", e.designFarPlane > 0 ? num(e.designFarPlane) : Json(nullptr)},
+            {"false_cull_objects", e.falseCullObjects},
+            {"false_cull_pixels", e.falseCullPixels},
+            {"objects", objects},
+            {"objects_omitted", e.objectsOmitted}};
+}
+
 // The audit against the reference visibility (analysis/audit.h; docs/audits.md).
 Json auditJson(const ViewResult &v) {
     const ReferenceVisibility &ref = v.reference;
@@ -452,6 +503,7 @@ Json auditJson(const ViewResult &v) {
                         {"beyond_far_plane_triangles", a.beyondFarPlaneTriangles},
                         {"beyond_far_plane_pixels", a.beyondFarPlanePixels},
                         {"by_stage", byStage}};
+    if (v.pvsEvidence.ran) j["pvs_evidence"] = pvsEvidenceJson(v.pvsEvidence);
     j["wasted_draws"] = {{"drawn_triangles", a.drawnTriangles},
                          {"drawn_objects", a.drawnObjects},
                          {"triangles", a.wastedTriangles},

@@ -21,6 +21,7 @@
 #include "analysis/load.h"
 #include "analysis/load_bsp.h"
 #include "analysis/pipeline.h"
+#include "analysis/pvs_evidence.h"
 #include "analysis/zip.h"
 
 using namespace va;
@@ -428,6 +429,95 @@ TEST(Bsp, TinyMapBrushEntities) {
         if (s.triangleObject[t] != kExcludedTriangle) all.push_back(t);
     const CullAudit a = auditCulling(s, ref, {{"cells", culled, {}}}, all, nullptr);
     EXPECT_EQ(a.falseCullPixels, 0u);
+}
+
+// The evidence of a false cull, on the tiny map with brush entities: from cluster 0 (which sees only
+// itself) looking towards -x, leaf 1's triangle, the door (model 5) and the bobbing platform (model
+// 3) are all in cluster 1, visible, and culled by the PVS.
+TEST(Audit, TinyMapPvsEvidence) {
+    const std::string p = writeFile("evidence.bsp", brushEntityWriter().file());
+    Scene s;
+    std::string err;
+    ASSERT_TRUE(loadBspScene(p, {}, {}, &s, &err)) << err;
+    ViewSpec v;
+    v.name = "look";
+    v.camera = quakeCamera(s, {50, 0, 59}, 180, 20);
+    PipelineSettings ps;
+    ps.width = 160, ps.height = 90;
+    ps.ordering = false, ps.zfight = false, ps.detail = false, ps.occlusion = false;
+    AnalysisResult out;
+    ASSERT_TRUE(analyzeScene(s, {v}, ps, nullptr, &out, &err)) << err;
+    const ViewResult &r = out.views[0];
+    const PvsEvidence &e = r.pvsEvidence;
+    ASSERT_TRUE(e.ran);
+    EXPECT_EQ(e.cameraLeaf, 0);
+    EXPECT_EQ(e.cameraCluster, 0);
+    EXPECT_EQ(e.designFarPlane, 0);
+    const StageCullAudit &cells = r.cullAudit.stages[0];
+    ASSERT_EQ(cells.stage, "cells");
+    EXPECT_EQ(e.falseCullPixels, cells.falseCullPixels);
+    EXPECT_EQ(e.falseCullObjects, cells.falseCullObjects);
+    ASSERT_EQ(e.objects.size(), 3u);
+    EXPECT_EQ(e.objectsOmitted, 0u);
+    std::map<std::string, const PvsObjectEvidence *> byName;
+    uint64_t pixels = 0;
+    for (size_t k = 0; k < e.objects.size(); ++k) {
+        const PvsObjectEvidence &o = e.objects[k];
+        byName[o.name] = &o;
+        pixels += o.pixels;
+        // Same order as the stage's worst offenders.
+        EXPECT_EQ(o.object, cells.worst[k].object);
+        EXPECT_EQ(o.pixels, cells.worst[k].pixels);
+        EXPECT_EQ(o.triangles, cells.worst[k].triangles);
+        ASSERT_EQ(o.clusters.size(), 1u);
+        EXPECT_EQ(o.clusters[0].cluster, 1);
+        EXPECT_EQ(o.clusters[0].pvsBit, 0);
+        EXPECT_GT(o.nearest, 0);
+    }
+    EXPECT_EQ(pixels, cells.falseCullPixels);
+    ASSERT_TRUE(byName.count("leaf1") && byName.count("model5") && byName.count("model3"));
+    // World faces: face 1, listed by leaf 1 only (cluster 1, bit 0).
+    const PvsObjectEvidence &leaf1 = *byName["leaf1"];
+    EXPECT_EQ(leaf1.model, 0u);
+    EXPECT_EQ(leaf1.entity, -1);
+    EXPECT_TRUE(leaf1.boxLeafs.empty());
+    ASSERT_EQ(leaf1.faces.size(), 1u);
+    EXPECT_EQ(leaf1.faces[0].face, 1u);
+    EXPECT_EQ(leaf1.faces[0].pixels, leaf1.pixels);
+    ASSERT_EQ(leaf1.faces[0].leafs.size(), 1u);
+    EXPECT_EQ(leaf1.faces[0].leafs[0].leaf, 1);
+    EXPECT_EQ(leaf1.faces[0].leafs[0].cluster, 1);
+    EXPECT_TRUE(leaf1.faces[0].leafs[0].inTree);
+    EXPECT_EQ(leaf1.faces[0].leafs[0].pvsBit, 0);
+    // The door: face 12, listed only by its own leaf 7 (cluster 0, out of the tree: bit 1, which
+    // does not count); its box reaches leaf 1 (cluster 1, bit 0).
+    const PvsObjectEvidence &door = *byName["model5"];
+    EXPECT_EQ(door.model, 5u);
+    EXPECT_EQ(door.classname, "func_door");
+    EXPECT_EQ(door.entity, 8);
+    ASSERT_EQ(door.boxLeafs.size(), 1u);
+    EXPECT_EQ(door.boxLeafs[0].leaf, 1);
+    EXPECT_EQ(door.boxLeafs[0].cluster, 1);
+    EXPECT_EQ(door.boxLeafs[0].pvsBit, 0);
+    ASSERT_EQ(door.faces.size(), 1u);
+    EXPECT_EQ(door.faces[0].face, 12u);
+    ASSERT_EQ(door.faces[0].leafs.size(), 1u);
+    EXPECT_EQ(door.faces[0].leafs[0].leaf, 7);
+    EXPECT_EQ(door.faces[0].leafs[0].cluster, 0);
+    EXPECT_FALSE(door.faces[0].leafs[0].inTree);
+    EXPECT_EQ(door.faces[0].leafs[0].pvsBit, 1);
+    // Each face's pixel shows a triangle of that face, falsely culled by the cells stage, at the
+    // distance given.
+    for (const PvsObjectEvidence &o : e.objects)
+        for (const PvsFaceEvidence &f : o.faces) {
+            const size_t i = size_t(f.y) * 160 + size_t(f.x);
+            ASSERT_GT(r.reference.id[i], 0u);
+            const uint32_t t = r.reference.id[i] - 1;
+            EXPECT_EQ(s.bsp->triangleFace[t], f.face);
+            EXPECT_EQ(s.triangleObject[t], o.object);
+            EXPECT_EQ(r.cullAudit.fate[i], kFateCulledFirst);
+            EXPECT_EQ(pixelPointDistance(r.camera, i, r.reference.depth[i]), f.nearest);
+        }
 }
 
 TEST(Bsp, PatchLevelSetsTriangleCount) {
@@ -1319,6 +1409,135 @@ TEST(Audit, RealMapsFarPlaneHiddenByDesign) {
     const Scene thor = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
     EXPECT_EQ(thor.bsp->farPlane.distance, 0);
     EXPECT_EQ(thor.views[0].camera.farZ, 6915);
+}
+
+// The evidence of the false culls left on a real map, checked against the map's bytes by a reader
+// of the test's own: the header's lump table; planes, nodes (the eye's leaf, and which leafs the
+// tree reaches), leafs (cluster, leafface range), leaffaces (every leaf listing a face), models (a
+// brush model's box leafs) and visdata (every PVS bit). oa_thor has 16 brush entities (all
+// triggers); from spawn34 and spawn76 (mirror images of each other) at 320x180 the PVS culls one
+// visible pixel each: a face 3,541 units away at the far edge of the floor, in clusters the PVS
+// rows of the camera's clusters leave out (docs/quake3.md, "Reading the evidence").
+namespace {
+struct RawBsp {
+    std::vector<uint8_t> f;
+    int32_t i32(size_t at) const { return get32(f, at); }
+    float f32(size_t at) const {
+        const int32_t v = get32(f, at);
+        float x;
+        std::memcpy(&x, &v, 4);
+        return x;
+    }
+    size_t lump(int l) const { return size_t(get32(f, 8 + 8 * l)); }
+    size_t count(int l, size_t rec) const { return size_t(get32(f, 12 + 8 * l)) / rec; }
+    int32_t leafCluster(int32_t l) const { return i32(lump(LLeafs) + 48 * size_t(l)); }
+    // The eye's leaf: down the tree, front when dot(normal, p) - dist >= 0.
+    int32_t leafAt(Vec3 p) const {
+        int32_t n = 0;
+        while (n >= 0) {
+            const size_t node = lump(LNodes) + 36 * size_t(n), pl = lump(LPlanes) + 16 * size_t(i32(node));
+            const double d = f32(pl) * p.x + f32(pl + 4) * p.y + f32(pl + 8) * p.z - f32(pl + 12);
+            n = i32(node + (d >= 0 ? 4 : 8));
+        }
+        return -(n + 1);
+    }
+    std::set<int32_t> treeLeafs() const {
+        std::set<int32_t> out;
+        std::vector<int32_t> todo{0};
+        while (!todo.empty()) {
+            const int32_t n = todo.back();
+            todo.pop_back();
+            if (n < 0) out.insert(-(n + 1));
+            else todo.push_back(i32(lump(LNodes) + 36 * size_t(n) + 4)), todo.push_back(i32(lump(LNodes) + 36 * size_t(n) + 8));
+        }
+        return out;
+    }
+    std::vector<int32_t> leafsListing(uint32_t face) const {
+        std::vector<int32_t> out;
+        for (size_t l = 0; l < count(LLeafs, 48); ++l) {
+            const size_t r = lump(LLeafs) + 48 * l;
+            for (int32_t k = 0; k < i32(r + 36); ++k)
+                if (uint32_t(i32(lump(LLeafFaces) + 4 * size_t(i32(r + 32) + k))) == face) out.push_back(int32_t(l));
+        }
+        return out;
+    }
+    int bit(int32_t from, int32_t to) const {
+        const size_t v = lump(LVisData);
+        return (f[v + 8 + size_t(from) * size_t(i32(v + 4)) + size_t(to / 8)] >> (to % 8)) & 1;
+    }
+};
+}  // namespace
+
+TEST(Audit, RealMapEvidenceAgreesWithTheFile) {
+    REQUIRE_OA("pak6-patch088.pk3");
+    const Scene s = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
+    const RawBsp raw{rawMap("pak6-patch088.pk3", "maps/oa_thor.bsp")};
+    const std::set<int32_t> inTree = raw.treeLeafs();
+    std::vector<ViewSpec> views;
+    for (const ViewSpec &v : s.views)
+        if (v.name == "spawn34" || v.name == "spawn76") views.push_back(v);
+    ASSERT_EQ(views.size(), 2u);
+    PipelineSettings ps;
+    ps.width = 320, ps.height = 180;
+    ps.ordering = false, ps.zfight = false, ps.detail = false;
+    AnalysisResult out;
+    std::string err;
+    ASSERT_TRUE(analyzeScene(s, views, ps, nullptr, &out, &err)) << err;
+    uint64_t faces = 0, leafs = 0, bits = 0, falsePixels = 0;
+    for (const ViewResult &r : out.views) {
+        const PvsEvidence &e = r.pvsEvidence;
+        ASSERT_TRUE(e.ran);
+        falsePixels += r.cullAudit.falseCullPixels;
+        // The camera: its leaf by the file's tree, its cluster by the file's leafs.
+        EXPECT_EQ(e.cameraLeaf, raw.leafAt(r.camera.eye)) << r.spec.name;
+        EXPECT_EQ(e.cameraCluster, raw.leafCluster(e.cameraLeaf)) << r.spec.name;
+        EXPECT_EQ(e.falseCullPixels, r.cullAudit.falseCullPixels);  // every false cull is the PVS's
+        EXPECT_EQ(e.objectsOmitted, 0u);
+        ASSERT_FALSE(e.objects.empty()) << r.spec.name;
+        for (const PvsObjectEvidence &o : e.objects) {
+            // Every cluster of the object: bit 0 in the camera cluster's row, read from the file.
+            for (const PvsClusterBit &c : o.clusters) {
+                EXPECT_EQ(c.pvsBit, raw.bit(e.cameraCluster, c.cluster));
+                EXPECT_EQ(c.pvsBit, 0) << o.name;
+                ++bits;
+            }
+            for (const PvsFaceEvidence &f : o.faces) {
+                ++faces;
+                // Every leaf listing the face, by the file's leaffaces; its cluster, whether the tree
+                // reaches it, its bit.
+                const std::vector<int32_t> listing = raw.leafsListing(f.face);
+                ASSERT_EQ(f.leafs.size() + f.leafsOmitted, listing.size());
+                for (size_t k = 0; k < f.leafs.size(); ++k) {
+                    const PvsLeafBit &l = f.leafs[k];
+                    EXPECT_EQ(l.leaf, listing[k]);
+                    EXPECT_EQ(l.cluster, raw.leafCluster(l.leaf));
+                    EXPECT_EQ(l.inTree, inTree.count(l.leaf) > 0);
+                    EXPECT_EQ(l.pvsBit, l.cluster < 0 ? -1 : raw.bit(e.cameraCluster, l.cluster));
+                    // A leaf of the tree listing the face: its cluster is one of the object's, bit 0.
+                    if (l.inTree && l.cluster >= 0) {
+                        EXPECT_EQ(l.pvsBit, 0) << o.name << " face " << f.face;
+                        bool listed = false;
+                        for (const PvsClusterBit &c : o.clusters) listed |= c.cluster == l.cluster;
+                        EXPECT_TRUE(listed) << o.name << " face " << f.face << " leaf " << l.leaf;
+                    }
+                    ++leafs;
+                }
+                // The face is seen at its pixel, culled falsely, no farther than the map allows.
+                const size_t i = size_t(f.y) * size_t(r.camera.width) + size_t(f.x);
+                ASSERT_GT(r.reference.id[i], 0u);
+                EXPECT_EQ(s.bsp->triangleFace[r.reference.id[i] - 1], f.face);
+                EXPECT_EQ(r.cullAudit.fate[i], kFateCulledFirst);
+                EXPECT_EQ(pixelPointDistance(r.camera, i, r.reference.depth[i]), f.nearest);
+            }
+        }
+        std::printf("  %s: camera leaf %d cluster %d; %zu object(s), first %s face %u at %.1f units\n",
+                    r.spec.name.c_str(), e.cameraLeaf, e.cameraCluster, e.objects.size(), e.objects[0].name.c_str(),
+                    e.objects[0].faces.empty() ? 0u : e.objects[0].faces[0].face, e.objects[0].nearest);
+    }
+    EXPECT_EQ(falsePixels, 2u);
+    EXPECT_EQ(faces, 2u);
+    EXPECT_GE(leafs, 3u);
+    EXPECT_GE(bits, 6u);
 }
 
 // Quake 3's winding, checked against the map's own normals: each polygon face stores its plane's
