@@ -152,7 +152,8 @@ enum class Disagreement : uint8_t {
                   //   triangle (edgeTolerance below): who covers it is decided by rounding
     tie = 2,      // both cover it and their depths at the center are equal in the view's depth
                   //   format, or within the ray caster's float depth error: a depth tie
-    genuine = 3,  // neither: a real error in the rasterizer, the ray caster or a culling stage
+    genuine = 3,  // neither: the two renderers disagree on the same triangles -- a bug in the
+                  //   rasterizer or the ray caster (a culling stage's error is a false cull instead)
 };
 
 // The coverage uncertainty, in pixels, of the two methods at an edge (docs/audits.md derives it):
@@ -168,12 +169,21 @@ enum class Disagreement : uint8_t {
 constexpr double kSnapEdgeTolerancePx = 1.4142135623730951 / 512;
 constexpr int kEmbreeEdgeOps = 16;
 
+// Like with like (docs/audits.md): the z-buffer draws what the culling stages kept, so it is compared
+// with the ray caster over the same triangles. A pixel where the ray caster over the whole scene
+// sees a triangle a culling stage removed is counted in `culled` (the culling audit judges it: a
+// false cull, hidden by design, a snapped sliver, or a cull the reference does not see at that
+// center), never as a disagreement; the two renderers are compared there too, on the same triangles.
 struct CrossCheck {
     int width = 0, height = 0;
     uint64_t pixels = 0;            // pixels compared
     uint64_t agree = 0;             // same visible triangle (or both background)
     uint64_t edge = 0, tie = 0, genuine = 0;  // disagreements by class; best genuine == 0
     uint64_t oneSidedBackground = 0;  // of the disagreements: one method saw background
+    uint64_t culled = 0;            // pixels where the whole-scene ray caster hits a triangle a culling
+                                    //   stage removed (set by the pipeline; not a disagreement class)
+    bool recast = false;            // the ray caster ran again over the z-buffer's triangle set for the
+                                    //   comparison (culled > 0); else its whole-scene image was that set's
     double maxRelativeDepthDifference = 0;  // over agreeing covered pixels: |d_ray - d_z| / d_z (measured)
     std::vector<uint8_t> cls;       // per pixel, Disagreement
     struct Example {

@@ -296,7 +296,6 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         opt.tiesToLowestId = true;
         opt.keepBarycentrics = ps.effects.tracesRays();
         r.raycastImage = ps.rays->castPrimary(cam, opt, &r.raycast);
-        st.ms = t0.ms();
         st.ran = true;
         r.raycastRan = true;
         st.trianglesIn = scene.objectTriangles.size();
@@ -308,9 +307,27 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             }
         // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
         st.trianglesCulled = st.trianglesIn - st.trianglesOut;
+        // Like with like: the z-buffer drew only what the culling stages kept (lists.triangles). Where
+        // the whole-scene rays hit a triangle outside that set, cast again over the set itself, so
+        // that a cull (judged by the culling audit) is never also counted as a disagreement.
+        std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
+        for (uint32_t t : lists.triangles) outOfSet[t] = 0;
+        uint64_t culledPixels = 0;
+        for (uint32_t id : r.raycastImage.id) culledPixels += id && outOfSet[id - 1];
+        RaycastImage sameSet;
+        if (culledPixels > 0) {
+            PrimaryOptions same = opt;
+            same.keepBarycentrics = false;
+            same.rejectSource = outOfSet.data();
+            sameSet = ps.rays->castPrimary(cam, same, nullptr);
+        }
+        st.ms = t0.ms();
         r.stages.push_back(st);
-        r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, r.raycastImage.id, r.raycastImage.depth, scene, cam,
+        const RaycastImage &compared = culledPixels > 0 ? sameSet : r.raycastImage;
+        r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, cam,
                                   makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ), ps.rays->origin());
+        r.crossCheck.culled = culledPixels;
+        r.crossCheck.recast = culledPixels > 0;
         if (ps.effects.tracesRays() && !stopped()) {
             r.effects = traceEffects(*ps.rays, cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
             r.effectsRan = true;
@@ -408,7 +425,7 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     //   writing images (one 8-bit RGBA or float image at a time, and the PNG encoder)   16
     uint64_t perPixel = 20 + 16;
     if (s.audit) perPixel += 13;
-    if (s.raycast) perPixel += 9;
+    if (s.raycast) perPixel += 17;  // + the cross-check's recast over the z-buffer's set (id, depth)
     if (s.zfight) perPixel += 33;
     const EffectPlan plan = planEffects(scene, s.effects);
     if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;

@@ -1428,6 +1428,12 @@ void HtmlWriter::raycast(const Json *v, const std::string &id, const std::vector
                 o += std::string("<tr><td>") + label(k) + "</td><td class=\"n" + (std::string(k) == "genuine" && *n > 0 ? " bad" : "") +
                      "\">" + fmtCount(*n) + "</td><td class=\"n\">" + pct(*n, px) + "</td></tr>";
         o += "</table></div>";
+        if (const auto culled = num(get(cc, "culled")); culled && *culled > 0)
+            o += "<p class=\"note\" id=\"" + id + "-culled\">Compared like with like: at " + plural(*culled, "pixel", "pixels") +
+                 " the ray caster over the whole scene hits a triangle a culling stage removed; the culling audit judges "
+                 "those (false culls, hidden by design), and there the z-buffer was compared with the ray caster over "
+                 "its own triangles. A genuine disagreement is one renderer disagreeing with the other on the same "
+                 "triangles: 0 means no renderer bug.</p>";
         const Json *ex = get(cc, "genuine_examples");
         const ViewImage *diff = findImage(imgs, "raycast");
         if (ex && ex->is_array() && !ex->empty()) {

@@ -344,6 +344,8 @@ Json raycastJson(const ViewResult &v, const std::vector<std::string> &lightNames
                         {"tie", c.tie},
                         {"genuine", c.genuine},
                         {"one_sided_background", c.oneSidedBackground},
+                        {"culled", c.culled},
+                        {"recast", c.recast},
                         {"max_relative_depth_difference", num(c.maxRelativeDepthDifference)},
                         {"genuine_examples", examples},
                         {"ms", num(c.ms)}};

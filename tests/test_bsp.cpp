@@ -1333,15 +1333,18 @@ TEST(Audit, RealMapsBrushEntitiesLeaveNoFalseCulls) {
         AnalysisResult out;
         std::string err;
         ASSERT_TRUE(analyzeScene(s, s.views, ps, nullptr, &out, &err)) << err;
-        uint64_t falsePixels = 0, cellsCulled = 0;
+        uint64_t falsePixels = 0, cellsCulled = 0, genuine = 0;
         for (const ViewResult &v : out.views) {
             falsePixels += v.cullAudit.falseCullPixels;
             cellsCulled += v.cells.objectsCulled;
+            genuine += v.crossCheck.genuine;
         }
-        std::printf("  %s: %zu views, PVS culled %llu objects, false-cull pixels %llu\n", path, out.views.size(),
-                    (unsigned long long)cellsCulled, (unsigned long long)falsePixels);
+        std::printf("  %s: %zu views, PVS culled %llu objects, false-cull pixels %llu, genuine %llu\n", path,
+                    out.views.size(), (unsigned long long)cellsCulled, (unsigned long long)falsePixels,
+                    (unsigned long long)genuine);
         EXPECT_GT(cellsCulled, 0u) << path;
         EXPECT_EQ(falsePixels, 0u) << path;
+        EXPECT_EQ(genuine, 0u) << path;
     }
 }
 
@@ -1404,6 +1407,26 @@ TEST(Audit, RealMapsFarPlaneHiddenByDesign) {
         EXPECT_EQ(falseOld, 0u) << w.path;
         EXPECT_EQ(beyondOld, w.beyondPixels) << w.path;
         EXPECT_EQ(falseNoPlane, beyondOld) << w.path;
+        // The whole pipeline with the old far plane: the cross-check compares like with like, so the
+        // hidden-by-design pixels are "culled", not genuine disagreements (before: 3 and 6 genuine).
+        std::vector<ViewSpec> views = s.views;
+        for (ViewSpec &v : views) v.camera.farZ = w.oldFar;
+        PipelineSettings ps;
+        ps.width = 160, ps.height = 90;
+        ps.ordering = false, ps.zfight = false, ps.detail = false, ps.occlusion = false;
+        AnalysisResult out;
+        std::string err;
+        ASSERT_TRUE(analyzeScene(s, views, ps, nullptr, &out, &err)) << err;
+        uint64_t genuine = 0, culled = 0, beyond = 0, falsePx = 0;
+        for (const ViewResult &v : out.views) {
+            genuine += v.crossCheck.genuine, culled += v.crossCheck.culled;
+            beyond += v.cullAudit.beyondFarPlanePixels, falsePx += v.cullAudit.falseCullPixels;
+            EXPECT_EQ(v.crossCheck.recast, v.crossCheck.culled > 0);
+        }
+        EXPECT_EQ(genuine, 0u) << w.path;
+        EXPECT_EQ(falsePx, 0u) << w.path;
+        EXPECT_EQ(beyond, w.beyondPixels) << w.path;
+        EXPECT_EQ(culled, w.beyondPixels) << w.path;
     }
     // A map without one keeps the diagonal's far plane.
     const Scene thor = loadReal(kOa + "pak6-patch088.pk3:maps/oa_thor.bsp");
