@@ -354,12 +354,19 @@ bool entityVec3(const std::string &s, Vec3 *out) {
 // straddles. In double from the float planes and box, and ties go both ways, so a box touching a
 // plane is never cut off (conservative). An explicit stack: nothing recurses on the file's depth.
 // Every node is reached at most once (each has one parent: children come after their parents).
-std::vector<int32_t> boxLeafs(const BspLevel &level, const Aabb &box) {
-    std::vector<int32_t> leafs;
-    if (level.leafs.empty()) return leafs;
-    if (level.nodes.empty()) return {0};
+// `steps`: what the walks may still visit, all models together; false when it runs out.
+bool boxLeafs(const BspLevel &level, const Aabb &box, uint64_t *steps, std::vector<int32_t> *out) {
+    std::vector<int32_t> &leafs = *out;
+    leafs.clear();
+    if (level.leafs.empty()) return true;
+    if (level.nodes.empty()) {
+        leafs.push_back(0);
+        return true;
+    }
     std::vector<int32_t> stack{0};
     while (!stack.empty()) {
+        if (*steps == 0) return false;
+        --*steps;
         const int32_t i = stack.back();
         stack.pop_back();
         if (i < 0) {
@@ -378,8 +385,9 @@ std::vector<int32_t> boxLeafs(const BspLevel &level, const Aabb &box) {
     }
     std::sort(leafs.begin(), leafs.end());
     leafs.erase(std::unique(leafs.begin(), leafs.end()), leafs.end());
-    return leafs;
+    return true;
 }
+
 
 bool Parser::models(BspLevel *level, uint64_t nFaces) {
     level->models.assign(count_[kModels], BspModel{});
@@ -423,6 +431,10 @@ bool Parser::models(BspLevel *level, uint64_t nFaces) {
                     }
                 }
     }
+    // The walks' budget (BspOptions::maxBoxWalkSteps), all models together: a real map's walks visit
+    // well under a million nodes (oa_thor's tree has 5,355); a hostile file with a million models
+    // over a million nodes would otherwise walk 10^12 (docs/limits.md, "Hostile files").
+    uint64_t steps = opt_.maxBoxWalkSteps;
     for (size_t k = 1; k < level->models.size(); ++k) {
         BspModel &m = level->models[k];
         // Never drawn: triggers (g_trigger.c's InitTrigger marks them SVF_NOCLIENT; trigger_push
@@ -432,8 +444,13 @@ bool Parser::models(BspLevel *level, uint64_t nFaces) {
         m.bounds.lo = m.bounds.lo + m.offset;
         m.bounds.hi = m.bounds.hi + m.offset;
         // The server links an entity with its box widened by 1 unit per side (sv_world.c,
-        // SV_LinkEntity: "movement is clipped an epsilon away from an actual edge").
-        if (m.drawn) m.boxLeafs = boxLeafs(*level, {m.bounds.lo - Vec3{1, 1, 1}, m.bounds.hi + Vec3{1, 1, 1}});
+        // SV_LinkEntity: "movement is clipped an epsilon away from an actual edge"). Only models
+        // with faces need their leafs (their faces become objects).
+        if (m.drawn && m.faceCount > 0 &&
+            !boxLeafs(*level, {m.bounds.lo - Vec3{1, 1, 1}, m.bounds.hi + Vec3{1, 1, 1}}, &steps, &m.boxLeafs))
+            return lumpFail(kModels, "the brush models' boxes reach more than " + str(int64_t(opt_.maxBoxWalkSteps)) +
+                                         " nodes of the tree (at model " + str(int64_t(k)) + " of " +
+                                         str(int64_t(level->models.size())) + "); the file is damaged");
     }
     return true;
 }

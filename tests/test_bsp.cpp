@@ -769,6 +769,22 @@ TEST(Bsp, TriangleBudgetRefusedBeforeAllocating) {
               "--max-triangles 1574502400, or the file is damaged");
 }
 
+// The brush models' box walks have a budget, all models together (a hostile file of a million
+// models over a million nodes would walk 10^12 nodes): over it, the file is refused.
+TEST(Bsp, BoxWalkBudgetRefusesHostileModels) {
+    const std::vector<uint8_t> f = brushEntityWriter().file();
+    BspOptions o;
+    // Model 1's walk: node 0, node 1, leaf 0 (3 steps); model 3's and model 5's: node 0, leaf 1 (2 each).
+    o.maxBoxWalkSteps = 6;
+    EXPECT_EQ(parseError(f, o), "tiny.bsp: lump 'models': the brush models' boxes reach more than 6 nodes of the "
+                                "tree (at model 5 of 6); the file is damaged");
+    o.maxBoxWalkSteps = 7;
+    SceneBuildInput in;
+    BspLevel lv;
+    std::string err;
+    EXPECT_TRUE(parseBsp(f.data(), f.size(), "tiny.bsp", o, &in, &lv, &err)) << err;
+}
+
 // Seeded byte corruption: every file is either read or refused with a message, and nothing crashes.
 // (The same kind of corruption of the real maps was run under AddressSanitizer and UBSan: docs/quake3.md.)
 TEST(Bsp, CorruptedBytesNeverCrash) {
