@@ -200,14 +200,21 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
 
 // ---- False culls and wasted draws ---------------------------------------------------------------
 
+double pixelPointDistance(const Camera &cam, size_t pixel, double depth) {
+    const size_t w = size_t(std::max(cam.width, 1));
+    const ViewRay r = viewRayThroughPixel(cam, double(pixel % w) + 0.5, double(pixel / w) + 0.5);
+    return length(r.origin + r.direction * depth);
+}
+
 CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const std::vector<StageCulls> &stages,
-                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource) {
+                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource,
+                       const Camera *cam) {
     const Stopwatch t0;
     CullAudit a;
     const size_t nt = scene.triangleCount();
 
     // The stage that culled each triangle first (1 + index; 0 = none). A per-pixel fate is a byte,
-    // 4 + k, so at most 252 stages (the pipeline has 5 culling stages).
+    // 5 + k, so at most 251 stages (the pipeline has 5 culling stages).
     const size_t nStages = std::min<size_t>(stages.size(), 255 - kFateCulledFirst + 1);
     std::vector<uint8_t> culledBy(nt, 0);
     a.stages.resize(nStages);
@@ -234,8 +241,35 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
         return stages[k].byFacing && t < ref.snappedFront.size() && ref.snappedFront[t];
     };
 
-    // False culls: culled triangles that the reference shows; aggregated per object for the
-    // worst-offender lists.
+    // Pixels of culled triangles: their point's distance from the eye, for the nearest false cull,
+    // and beyond a stage's design far plane, hidden by design (beyondPx: per triangle, such pixels;
+    // beyond: per pixel). One pass over the pixels, only with a camera.
+    std::vector<uint32_t> beyondPx;
+    std::vector<uint8_t> beyond;
+    bool anyFarPlane = false;
+    for (size_t k = 0; k < nStages; ++k) {
+        a.stages[k].designFarPlane = cam ? std::max(stages[k].designFarPlane, 0.0) : 0.0;
+        anyFarPlane |= a.stages[k].designFarPlane > 0;
+    }
+    if (cam && !ref.pixelsOf.empty()) {
+        if (anyFarPlane) beyondPx.assign(nt, 0), beyond.assign(ref.id.size(), 0);
+        for (size_t i = 0; i < ref.id.size(); ++i) {
+            const uint32_t id = ref.id[i];
+            if (!id || !culledBy[id - 1] || isSnapped(id - 1, culledBy[id - 1] - 1)) continue;
+            StageCullAudit &sa = a.stages[culledBy[id - 1] - 1];
+            const double d = pixelPointDistance(*cam, i, ref.depth[i]);
+            if (sa.designFarPlane > 0 && d > sa.designFarPlane) {
+                ++beyondPx[id - 1];
+                beyond[i] = 1;
+                if (sa.beyondFarPlaneNearest == 0 || d < sa.beyondFarPlaneNearest) sa.beyondFarPlaneNearest = d;
+            } else if (sa.falseCullNearest == 0 || d < sa.falseCullNearest) {
+                sa.falseCullNearest = d;
+            }
+        }
+    }
+
+    // False culls: culled triangles that the reference shows (at a pixel within the stage's design
+    // far plane, when it has one); aggregated per object for the worst-offender lists.
     struct Agg {
         uint64_t triangles = 0, pixels = 0;
     };
@@ -249,11 +283,17 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
             sa.snappedPixels += ref.pixelsOf[t];
             continue;
         }
+        const uint64_t far = beyondPx.empty() ? 0 : beyondPx[t], near = ref.pixelsOf[t] - far;
+        sa.beyondFarPlanePixels += far;
+        if (near == 0) {
+            ++sa.beyondFarPlaneTriangles;
+            continue;
+        }
         ++sa.falseCullTriangles;
-        sa.falseCullPixels += ref.pixelsOf[t];
+        sa.falseCullPixels += near;
         Agg &g = perObject[k][scene.triangleObject[t]];
         ++g.triangles;
-        g.pixels += ref.pixelsOf[t];
+        g.pixels += near;
     }
     for (size_t k = 0; k < nStages; ++k) {
         StageCullAudit &sa = a.stages[k];
@@ -267,6 +307,8 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
         if (sa.worst.size() > kWorstOffenders) sa.worst.resize(kWorstOffenders);
         a.falseCullTriangles += sa.falseCullTriangles;
         a.falseCullPixels += sa.falseCullPixels;
+        a.beyondFarPlaneTriangles += sa.beyondFarPlaneTriangles;
+        a.beyondFarPlanePixels += sa.beyondFarPlanePixels;
     }
 
     // Wasted draws: reached the z-buffer, visible nowhere in the reference.
@@ -302,6 +344,7 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
         const uint32_t t = id - 1;
         if (drawn[t]) a.fate[i] = kFateDrawn;
         else if (culledBy[t] && isSnapped(t, culledBy[t] - 1)) a.fate[i] = kFateSnapped;
+        else if (culledBy[t] && !beyond.empty() && beyond[i]) a.fate[i] = kFateBeyondFarPlane;
         else if (culledBy[t]) a.fate[i] = uint8_t(kFateCulledFirst + culledBy[t] - 1);
         else {
             a.fate[i] = kFateUnaccounted;

@@ -78,6 +78,13 @@ struct StageCulls {
     bool byFacing = false;            // culls by the side facing the eye (backface): its culled
                                       //   triangles the reference shows only as snapped slivers
                                       //   (ReferenceVisibility::snappedFront) are not false culls
+    // > 0: the stage's data was built to leave out what lies farther than this from the eye on
+    // purpose (a Quake 3 map's designed far plane, BspFarPlane: its PVS drops portal pairs farther
+    // apart). A culled triangle's pixel whose visible point lies farther than this from the eye
+    // (Euclidean, in double) is "beyond the far plane, hidden by design", not a false cull; a pixel
+    // at or within it is a false cull, since such a point cannot have been dropped by the distance
+    // rule (docs/quake3.md, "The far plane"). Needs auditCulling's camera.
+    double designFarPlane = 0;
 };
 
 constexpr size_t kWorstOffenders = 20;
@@ -98,6 +105,13 @@ struct StageCullAudit {
     uint64_t falseCullPixels = 0;     // reference pixels showing a falsely culled triangle; best 0
     uint64_t snappedTriangles = 0;    // byFacing: culled triangles the reference shows only as
     uint64_t snappedPixels = 0;       //   snapped slivers, and their pixels (rounding, not false culls)
+    double designFarPlane = 0;        // StageCulls::designFarPlane (0: none)
+    uint64_t beyondFarPlaneTriangles = 0;  // culled triangles visible only at pixels beyond the design far
+                                           //   plane: hidden by design, not false culls
+    uint64_t beyondFarPlanePixels = 0;     // reference pixels of culled triangles beyond it (not false culls)
+    double beyondFarPlaneNearest = 0;      // the nearest of those pixels' points from the eye (0: none);
+                                           //   always > designFarPlane
+    double falseCullNearest = 0;      // the nearest false-cull pixel's point from the eye (0: none or no camera)
     std::vector<FalseCullOffender> worst;  // up to kWorstOffenders, most pixels first (ties: more
                                            //   triangles, then lower object index)
 };
@@ -109,7 +123,8 @@ enum : uint8_t {
     kFateUnaccounted = 2,    // its triangle neither reached the z-buffer nor was culled by a listed
                              //   stage (dropped elsewhere: a pipeline bug); best: no such pixel
     kFateSnapped = 3,        // culled by facing, shown by the reference only as a snapped sliver
-    kFateCulledFirst = 4,    // 4 + k: falsely culled by stages[k]
+    kFateBeyondFarPlane = 4, // culled by a stage with a design far plane, the point beyond it: by design
+    kFateCulledFirst = 5,    // 5 + k: falsely culled by stages[k]
 };
 
 struct CullAudit {
@@ -117,6 +132,8 @@ struct CullAudit {
     uint64_t falseCullTriangles = 0;      // sums over the stages; best 0
     uint64_t falseCullPixels = 0;         // best 0
     uint64_t unaccountedPixels = 0;       // pixels of kFateUnaccounted; best 0
+    uint64_t beyondFarPlanePixels = 0;    // sums over the stages: pixels hidden by design (not false culls)
+    uint64_t beyondFarPlaneTriangles = 0;
     // Wasted draws: what reached the z-buffer (passed every culling stage) yet is visible nowhere
     // in the reference. Best 0; the floor is set by what conservative object-level tests can know.
     uint64_t drawnTriangles = 0;          // triangles that reached the z-buffer
@@ -133,8 +150,16 @@ struct CullAudit {
 // `drawnTriangles`: the source triangles that reached the z-buffer (the last culling stage's
 // output, TriangleLists::triangles). `fragmentsPerSource`: per source triangle, the fragments of
 // the pipeline's z-buffer pass (ZBufferSettings::fragmentsPerSource), or null (fragments 0).
+// `cam`: the reference's camera, for the distances (a stage's designFarPlane, falseCullNearest);
+// null: no distances, and designFarPlane is ignored.
 CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const std::vector<StageCulls> &stages,
-                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource);
+                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource,
+                       const Camera *cam = nullptr);
+
+// The distance from the eye to the point a pixel center's ray meets at view depth `depth`
+// (perspective: depth |D| with D the view ray through the center, z = -1; orthographic: the point's
+// distance from the eye, the ray starting in the view plane).
+double pixelPointDistance(const Camera &cam, size_t pixel, double depth);
 
 // ---- Z-buffer against ray casting ---------------------------------------------------------------
 
@@ -144,7 +169,8 @@ enum class Disagreement : uint8_t {
                   //   triangle (edgeTolerance below): who covers it is decided by rounding
     tie = 2,      // both cover it and their depths at the center are equal in the view's depth
                   //   format, or within the ray caster's float depth error: a depth tie
-    genuine = 3,  // neither: a real error in the rasterizer, the ray caster or a culling stage
+    genuine = 3,  // neither: the two renderers disagree on the same triangles -- a bug in the
+                  //   rasterizer or the ray caster (a culling stage's error is a false cull instead)
 };
 
 // The coverage uncertainty, in pixels, of the two methods at an edge (docs/audits.md derives it):
@@ -160,12 +186,21 @@ enum class Disagreement : uint8_t {
 constexpr double kSnapEdgeTolerancePx = 1.4142135623730951 / 512;
 constexpr int kEmbreeEdgeOps = 16;
 
+// Like with like (docs/audits.md): the z-buffer draws what the culling stages kept, so it is compared
+// with the ray caster over the same triangles. A pixel where the ray caster over the whole scene
+// sees a triangle a culling stage removed is counted in `culled` (the culling audit judges it: a
+// false cull, hidden by design, a snapped sliver, or a cull the reference does not see at that
+// center), never as a disagreement; the two renderers are compared there too, on the same triangles.
 struct CrossCheck {
     int width = 0, height = 0;
     uint64_t pixels = 0;            // pixels compared
     uint64_t agree = 0;             // same visible triangle (or both background)
     uint64_t edge = 0, tie = 0, genuine = 0;  // disagreements by class; best genuine == 0
     uint64_t oneSidedBackground = 0;  // of the disagreements: one method saw background
+    uint64_t culled = 0;            // pixels where the whole-scene ray caster hits a triangle a culling
+                                    //   stage removed (set by the pipeline; not a disagreement class)
+    bool recast = false;            // the ray caster ran again over the z-buffer's triangle set for the
+                                    //   comparison (culled > 0); else its whole-scene image was that set's
     double maxRelativeDepthDifference = 0;  // over agreeing covered pixels: |d_ray - d_z| / d_z (measured)
     std::vector<uint8_t> cls;       // per pixel, Disagreement
     struct Example {

@@ -59,6 +59,9 @@ CameraSpec quakeCamera(const Scene &scene, Vec3 eye, double yawDeg, double pitch
     c.nearZ = 4;
     const double diag = scene.bounds.empty() ? 0 : length(scene.bounds.extent());
     c.farZ = std::max(std::ceil(diag), 64.0) + 16;
+    // A map with a designed far plane (_farplanedist) is meant to be seen up to it: its PVS leaves
+    // out what lies farther on purpose, and the game hides it (fog, a fog hull).
+    if (scene.bsp && scene.bsp->farPlane.distance > c.nearZ) c.farZ = std::min(c.farZ, scene.bsp->farPlane.distance);
     return c;
 }
 

@@ -21,7 +21,8 @@ constexpr double kQuakeFloorEye = kQuakeOriginAboveFeet + kQuakeViewHeight;
 // The camera Quake 3 uses by default, looking from `eye` along yaw (degrees about +z, 0 = +x) and
 // pitch (degrees, positive looks down): horizontal fov 90 (cg_fov) at 1920x1080, so
 // fov_y = 2 atan(tan 45 deg * 1080/1920) = 58.7155 deg; near 4 (r_znear); far = the map's bounding
-// box diagonal rounded up plus 16, so nothing in the map is clipped by far.
+// box diagonal rounded up plus 16, so nothing in the map is clipped by far -- or the map's designed
+// far plane (BspFarPlane, "_farplanedist") when it has one nearer than that.
 CameraSpec quakeCamera(const Scene &scene, Vec3 eye, double yawDeg, double pitchDeg = 0);
 
 // Views at the map's spawn points, in entity order: info_player_deathmatch, info_player_start,

@@ -1,21 +1,28 @@
 // Quake 3 BSP (IBSP v46) loader. Structure:
 //   1. Header: magic, version, 17 lumps; every lump inside the file and a whole number of records.
 //   2. Records decoded lump by lump, every index checked (planes, nodes, leafs, leaffaces, models,
-//      shaders, vertexes, meshverts, faces, visdata, entities).
-//   3. Faces classified (drawn, sky, nodraw, non-solid, billboard, bad) and counted; the triangles
-//      the drawn faces will make counted, and refused over the limit, before anything is allocated.
-//   4. Faces assigned to objects: a face goes to the first leaf that lists it; faces of brush models
-//      no leaf lists go to "modelK"; drawn world faces no leaf lists to "unleafed". Each object
+//      shaders, vertexes, meshverts, faces, visdata, entities); the brush models matched with the
+//      entities that spawn them ("model" "*K"), placed at their origin, and walked through the
+//      world's tree with their box (the engine's CM_BoxLeafnums); the worldspawn's far plane.
+//   3. Faces classified (drawn, faces of entities the engine never draws, sky, nodraw, non-solid,
+//      billboard, bad) and counted; the triangles the drawn faces will make counted, and refused
+//      over the limit, before anything is allocated.
+//   4. Faces assigned to objects: a world face goes to the first leaf of the world's tree that
+//      lists it; a brush model's faces to "modelK" (the leafs listing them are the model's own,
+//      which the tree never reaches); drawn world faces no such leaf lists to "unleafed". Each object
 //      records every cluster holding one of its faces (a face listed by leafs of several clusters is
-//      visible from any of them: keeping the union is what keeps the cells stage conservative).
+//      visible from any of them: keeping the union is what keeps the cells stage conservative); a
+//      model, the clusters of the leafs its box reaches.
 //   5. Geometry emitted per object: polygons and meshes from meshverts (offset by the face's first
-//      vertex) with each triangle's winding reversed; patches tessellated on one grid per face.
+//      vertex) with each triangle's winding reversed; patches tessellated on one grid per face; a
+//      brush model's moved to where its entity draws it. Each triangle remembers its face.
 // Byte layout (little-endian) per lump is written next to its decoder; docs/quake3.md has the table.
 #include "analysis/load_bsp.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -44,11 +51,11 @@ constexpr uint32_t kHeaderBytes = 8 + 8 * kLumpCount;
 constexpr uint32_t kSurfSky = 0x4, kSurfNodraw = 0x80, kSurfHint = 0x100, kSurfSkip = 0x200,
                    kSurfNonSolid = 0x4000;
 constexpr uint32_t kContentsLava = 0x8, kContentsSlime = 0x10, kContentsWater = 0x20, kContentsFog = 0x40,
-                   kContentsTranslucent = 0x20000000;
+                   kContentsAreaPortal = 0x8000, kContentsTranslucent = 0x20000000;
 
 // Face types (MST_*).
 enum FaceType { kBad = 0, kPolygon = 1, kPatch = 2, kMesh = 3, kBillboard = 4 };
-enum FaceKind : uint8_t { kDrawn, kKindBad, kKindBillboard, kKindSky, kKindNodraw, kKindNonSolid };
+enum FaceKind : uint8_t { kDrawn, kKindBad, kKindBillboard, kKindEntity, kKindSky, kKindNodraw, kKindNonSolid };
 
 uint32_t u32(const uint8_t *p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
 int32_t i32(const uint8_t *p) { return int32_t(u32(p)); }
@@ -101,6 +108,8 @@ private:
     bool visdata(BspLevel *level);
     bool faces(std::vector<Face> *out);
     bool brushes(BspLevel *level);
+    bool models(BspLevel *level, uint64_t nFaces);
+    void worldspawnKeys(BspLevel *level);
 };
 
 // ---- 1. Header --------------------------------------------------------------------------------------
@@ -377,6 +386,160 @@ bool Parser::faces(std::vector<Face> *out) {
     return true;
 }
 
+// ---- Brush models and their entities ------------------------------------------------------------------
+
+// Three numbers, as an entity's "origin" holds them; false (and *out untouched) otherwise.
+bool entityVec3(const std::string &s, Vec3 *out) {
+    const char *p = s.c_str();
+    double v[3];
+    for (double &x : v) {
+        char *end = nullptr;
+        x = std::strtod(p, &end);
+        if (end == p || !std::isfinite(x)) return false;
+        p = end;
+    }
+    *out = {v[0], v[1], v[2]};
+    return true;
+}
+
+// The leafs a box reaches walking the tree from the root (Quake 3's CM_BoxLeafnums): a node sends
+// the walk to its front child when the box's farthest corner along the normal is on the front
+// (dot >= dist) and to its back child when its nearest corner is behind (dot < dist) -- both when it
+// straddles. In double from the float planes and box, and ties go both ways, so a box touching a
+// plane is never cut off (conservative). An explicit stack: nothing recurses on the file's depth.
+// Every node is reached at most once (each has one parent: children come after their parents).
+// `steps`: what the walks may still visit, all models together; false when it runs out.
+bool boxLeafs(const BspLevel &level, const Aabb &box, uint64_t *steps, std::vector<int32_t> *out) {
+    std::vector<int32_t> &leafs = *out;
+    leafs.clear();
+    if (level.leafs.empty()) return true;
+    if (level.nodes.empty()) {
+        leafs.push_back(0);
+        return true;
+    }
+    std::vector<int32_t> stack{0};
+    while (!stack.empty()) {
+        if (*steps == 0) return false;
+        --*steps;
+        const int32_t i = stack.back();
+        stack.pop_back();
+        if (i < 0) {
+            leafs.push_back(-(i + 1));
+            continue;
+        }
+        const BspNode &n = level.nodes[size_t(i)];
+        const BspPlane &pl = level.planes[n.plane];
+        double lo = -pl.dist, hi = -pl.dist;
+        for (int a = 0; a < 3; ++a) {
+            const double x0 = pl.normal[a] * box.lo[a], x1 = pl.normal[a] * box.hi[a];
+            lo += std::min(x0, x1), hi += std::max(x0, x1);
+        }
+        if (hi >= 0) stack.push_back(n.children[0]);
+        if (lo < 0) stack.push_back(n.children[1]);
+    }
+    std::sort(leafs.begin(), leafs.end());
+    leafs.erase(std::unique(leafs.begin(), leafs.end()), leafs.end());
+    return true;
+}
+
+
+bool Parser::models(BspLevel *level, uint64_t nFaces) {
+    level->models.assign(count_[kModels], BspModel{});
+    for (uint64_t i = 0; i < count_[kModels]; ++i) {
+        const uint8_t *p = rec(kModels, i);
+        BspModel &m = level->models[i];
+        m.bounds.lo = vec3f(p), m.bounds.hi = vec3f(p + 12);
+        const int32_t face = i32(p + 24), n = i32(p + 28);
+        if (!inRange(face, n, nFaces))
+            return lumpFail(kModels, "model " + str(int64_t(i)) + " face range " + range(face, n) + " exceeds the " +
+                                         str(int64_t(nFaces)) + " faces; the file is damaged");
+        if (!isFinite(m.bounds.lo) || !isFinite(m.bounds.hi))
+            return lumpFail(kModels, "model " + str(int64_t(i)) + " bounds are not finite (NaN or infinity); the file is damaged");
+        m.firstFace = uint32_t(face), m.faceCount = uint32_t(n);
+    }
+    // The entity spawning each model: the first with "model" "*K" (the game's G_SpawnEntitiesFromString
+    // reads every entity; two naming one model would draw it twice, at the first's place here).
+    for (size_t e = 0; e < level->entities.size(); ++e) {
+        const std::string *mv = level->entities[e].get("model");
+        if (!mv || mv->size() < 2 || (*mv)[0] != '*' || mv->size() > 11 ||
+            mv->find_first_not_of("0123456789", 1) != std::string::npos)
+            continue;
+        const uint64_t k = std::stoull(mv->substr(1));
+        if (k == 0 || k >= level->models.size() || level->models[k].entity >= 0) continue;
+        BspModel &m = level->models[k];
+        m.entity = int32_t(e);
+        const BspEntity &ent = level->entities[e];
+        if (const std::string *c = ent.get("classname")) m.classname = *c;
+        // Where the game draws it: at the entity's origin (the model's vertices are relative to its
+        // origin brush when it had one, else world positions and no "origin"). A func_train starts
+        // at its first path_corner (g_mover.c: Reached_Train copies the target's origin to pos1).
+        Vec3 o;
+        if (const std::string *os = ent.get("origin"); os && entityVec3(*os, &o)) m.offset = o;
+        if (m.classname == "func_train")
+            if (const std::string *t = ent.get("target"))
+                for (const BspEntity &d : level->entities) {
+                    const std::string *tn = d.get("targetname"), *to = d.get("origin");
+                    if (tn && *tn == *t && to && entityVec3(*to, &o)) {
+                        m.offset = o;
+                        break;
+                    }
+                }
+    }
+    // The walks' budget (BspOptions::maxBoxWalkSteps), all models together: a real map's walks visit
+    // well under a million nodes (oa_thor's tree has 5,355); a hostile file with a million models
+    // over a million nodes would otherwise walk 10^12 (docs/limits.md, "Hostile files").
+    uint64_t steps = opt_.maxBoxWalkSteps;
+    for (size_t k = 1; k < level->models.size(); ++k) {
+        BspModel &m = level->models[k];
+        // Never drawn: triggers (g_trigger.c's InitTrigger marks them SVF_NOCLIENT; trigger_push
+        // and trigger_teleport go to clients for prediction only, and cg_ents.c draws nothing for
+        // ET_PUSH_TRIGGER / ET_TELEPORT_TRIGGER), and models no entity spawns.
+        m.drawn = m.entity >= 0 && m.classname.rfind("trigger_", 0) != 0;
+        m.bounds.lo = m.bounds.lo + m.offset;
+        m.bounds.hi = m.bounds.hi + m.offset;
+        // The server links an entity with its box widened by 1 unit per side (sv_world.c,
+        // SV_LinkEntity: "movement is clipped an epsilon away from an actual edge"). Only models
+        // with faces need their leafs (their faces become objects).
+        if (m.drawn && m.faceCount > 0 &&
+            !boxLeafs(*level, {m.bounds.lo - Vec3{1, 1, 1}, m.bounds.hi + Vec3{1, 1, 1}}, &steps, &m.boxLeafs))
+            return lumpFail(kModels, "the brush models' boxes reach more than " + str(int64_t(opt_.maxBoxWalkSteps)) +
+                                         " nodes of the tree (at model " + str(int64_t(k)) + " of " +
+                                         str(int64_t(level->models.size())) + "); the file is damaged");
+    }
+    return true;
+}
+
+// The worldspawn's far plane (q3map2's vis.cpp reads "_farplanedist", or "fogclip" / "distancecull"
+// of other games: atof of the value, its last character the mode) and a map-wide fog shader
+// ("_fog" / "fog", q3map2's fog.cpp).
+void Parser::worldspawnKeys(BspLevel *level) {
+    const BspEntity *ws = nullptr;
+    for (const BspEntity &e : level->entities)
+        if (const std::string *c = e.get("classname"); c && *c == "worldspawn") {
+            ws = &e;
+            break;
+        }
+    if (!ws) return;
+    for (const char *key : {"_farplanedist", "fogclip", "distancecull"}) {
+        const std::string *v = ws->get(key);
+        if (!v) continue;
+        const double d = std::strtod(v->c_str(), nullptr);
+        if (std::isfinite(d) && d > 0) {
+            level->farPlane.distance = d;
+            level->farPlane.key = key;
+            level->farPlane.value = *v;
+            const char last = v->empty() ? 0 : v->back();
+            level->farPlane.mode = (last == 'o' || last == 'e' || last == 'r') ? last : 0;
+        }
+        break;
+    }
+    for (const char *key : {"_fog", "fog"})
+        if (const std::string *v = ws->get(key)) {
+            level->fogShader = *v;
+            break;
+        }
+}
+
 // ---- Patches: biquadratic Bezier, one grid per face -----------------------------------------------
 
 // B(t) = (1-t)^2 P0 + 2t(1-t) P1 + t^2 P2; at t = 0 and t = 1 it is exactly P0 and P2, so
@@ -438,10 +601,25 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
     for (size_t i = 0; i < fs.size(); ++i) level->faceShader[i] = uint32_t(fs[i].shader);
     level->patchLevel = L;
     const uint64_t nf = fs.size();
+    worldspawnKeys(level);
 
     // Shaders: char name[64], int surfaceFlags, int contents (72 bytes).
     auto flagsOf = [&](const Face &f) { return u32(rec(kShaders, uint64_t(f.shader)) + 64); };
     auto contentsOf = [&](const Face &f) { return u32(rec(kShaders, uint64_t(f.shader)) + 68); };
+
+    // Models: float mins[3], maxs[3]; int face, n_faces, brush, n_brushes (40 bytes). Model 0 is the
+    // world; the others are brush entities (doors, platforms, movers, triggers).
+    if (!models(level, nf)) return false;
+    if (!level->models.empty())
+        level->worldFirstFace = level->models[0].firstFace, level->worldFaceCount = level->models[0].faceCount;
+    // modelOf[f]: the first model holding face f (kNone: none).
+    constexpr uint32_t kNone = 0xFFFFFFFFu;
+    std::vector<uint32_t> modelOf(nf, kNone);
+    for (size_t m = 0; m < level->models.size(); ++m) {
+        const BspModel &md = level->models[m];
+        for (uint32_t k = 0; k < md.faceCount; ++k)
+            if (modelOf[md.firstFace + k] == kNone) modelOf[md.firstFace + k] = uint32_t(m);
+    }
 
     // 3. Classify, count, and bound the output before allocating it.
     BspFaceCounts &fc = level->faceCounts;
@@ -453,11 +631,14 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         const uint32_t flags = flagsOf(f), contents = contentsOf(f);
         const uint64_t tris = f.type == kPatch ? patchTriangles(f, L)
                               : (f.type == kPolygon || f.type == kMesh) ? uint64_t(f.nMeshverts / 3) : 0;
+        BspModel *model = modelOf[i] != kNone ? &level->models[modelOf[i]] : nullptr;
         FaceKind k = kDrawn;
         if (f.type == kBad) k = kKindBad;
         else if (f.type == kBillboard) k = kKindBillboard;
+        else if (model && !model->drawn) k = kKindEntity;  // the whole entity is never drawn
         else if (flags & kSurfSky) k = kKindSky;
-        else if (flags & (kSurfNodraw | kSurfHint | kSurfSkip)) k = kKindNodraw;
+        // Tool surfaces: nodraw (clip and trigger brushes' shaders carry it), hint, skip, area portals.
+        else if ((flags & (kSurfNodraw | kSurfHint | kSurfSkip)) || (contents & kContentsAreaPortal)) k = kKindNodraw;
         // Non-solid and see-through: liquid and fog volumes, and non-solid translucent shaders
         // (light beams, flares of glass). They are blended over the scene and hide nothing.
         else if ((contents & (kContentsLava | kContentsSlime | kContentsWater | kContentsFog)) ||
@@ -467,6 +648,10 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         switch (k) {
         case kKindBad: ++fc.bad; break;
         case kKindBillboard: ++fc.billboards; break;
+        case kKindEntity:
+            ++fc.notDrawnEntity, fc.notDrawnEntityTriangles += tris;
+            ++model->notDrawnFaces, model->notDrawnTriangles += tris;
+            break;
         case kKindSky: ++fc.sky, fc.skyTriangles += tris; break;
         case kKindNodraw: ++fc.nodraw, fc.nodrawTriangles += tris; break;
         case kKindNonSolid: ++fc.nonSolid, fc.nonSolidTriangles += tris; break;
@@ -486,111 +671,78 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
                     " triangles; lower the patch level (--patch-level) or raise the limit with --max-triangles " +
                     str(int64_t(drawnTriangles)) + ", or the file is damaged");
 
-    // Models: float mins[3], maxs[3]; int face, n_faces, brush, n_brushes (40 bytes). Model 0 is the
-    // world; the others are brush entities (doors, platforms, movers) stored where they rest.
-    struct Model {
-        Aabb box;
-        int32_t face, nFaces;
-    };
-    std::vector<Model> models(count_[kModels]);
-    for (uint64_t i = 0; i < count_[kModels]; ++i) {
-        const uint8_t *p = rec(kModels, i);
-        Model &m = models[i];
-        m.box.lo = vec3f(p), m.box.hi = vec3f(p + 12);
-        m.face = i32(p + 24), m.nFaces = i32(p + 28);
-        if (!inRange(m.face, m.nFaces, nf))
-            return lumpFail(kModels, "model " + str(int64_t(i)) + " face range " + range(m.face, m.nFaces) +
-                                         " exceeds the " + str(int64_t(nf)) + " faces; the file is damaged");
-    }
-    if (!models.empty()) level->worldFirstFace = uint32_t(models[0].face), level->worldFaceCount = uint32_t(models[0].nFaces);
-
-    // 4. Objects. owner[f]: the first leaf listing face f; modelOf[f]: the first model holding it.
-    constexpr uint32_t kNone = 0xFFFFFFFFu;
-    std::vector<uint32_t> owner(nf, kNone), modelOf(nf, kNone);
-    for (size_t l = 0; l < level->leafs.size(); ++l) {
-        const BspLeaf &lf = level->leafs[l];
-        for (uint32_t k = 0; k < lf.leafFaceCount; ++k) {
-            const uint32_t f = level->leafFaces[lf.firstLeafFace + k];
-            if (owner[f] == kNone) owner[f] = uint32_t(l);
+    // 4. Objects. The leafs the world's tree reaches: the nodes are in pre-order (children after
+    // their parents, checked by nodes()), so one pass in order marks every reachable node and leaf.
+    const size_t nl = level->leafs.size();
+    level->leafInTree.assign(nl, 0);
+    if (level->nodes.empty()) {
+        if (nl > 0) level->leafInTree[0] = 1;
+    } else {
+        std::vector<uint8_t> nodeInTree(level->nodes.size(), 0);
+        nodeInTree[0] = 1;
+        for (size_t i = 0; i < level->nodes.size(); ++i) {
+            if (!nodeInTree[i]) continue;
+            for (int32_t ch : level->nodes[i].children) {
+                if (ch >= 0) nodeInTree[size_t(ch)] = 1;
+                else level->leafInTree[size_t(-(int64_t(ch) + 1))] = 1;
+            }
         }
     }
-    for (size_t m = 0; m < models.size(); ++m)
-        for (int32_t k = 0; k < models[m].nFaces; ++k)
-            if (modelOf[size_t(models[m].face + k)] == kNone) modelOf[size_t(models[m].face + k)] = uint32_t(m);
-
-    // Every cluster listing each face (CSR: faceClusters[faceBegin[f] .. faceBegin[f + 1])).
-    std::vector<uint32_t> faceBegin(nf + 1, 0);
-    for (const auto &lf : level->leafs)
-        if (lf.cluster >= 0)
-            for (uint32_t k = 0; k < lf.leafFaceCount; ++k) ++faceBegin[level->leafFaces[lf.firstLeafFace + k] + 1];
-    for (uint64_t f = 0; f < nf; ++f) faceBegin[f + 1] += faceBegin[f];
-    std::vector<int32_t> faceClusters(faceBegin[nf]);
+    // Every leaf listing each face, ascending (CSR), and owner[f]: the first leaf of the world's tree
+    // listing face f. A model's faces are listed only by leafs of its own (cluster 0, zero bounds)
+    // that the tree never reaches: they say nothing about where the model is.
+    level->faceLeafsBegin.assign(nf + 1, 0);
+    for (const BspLeaf &lf : level->leafs)
+        for (uint32_t k = 0; k < lf.leafFaceCount; ++k) ++level->faceLeafsBegin[level->leafFaces[lf.firstLeafFace + k] + 1];
+    for (uint64_t f = 0; f < nf; ++f) level->faceLeafsBegin[f + 1] += level->faceLeafsBegin[f];
+    level->faceLeafs.assign(level->faceLeafsBegin[nf], 0);
     {
-        std::vector<uint32_t> fill(faceBegin.begin(), faceBegin.end() - 1);
-        for (const auto &lf : level->leafs)
-            if (lf.cluster >= 0)
-                for (uint32_t k = 0; k < lf.leafFaceCount; ++k)
-                    faceClusters[fill[level->leafFaces[lf.firstLeafFace + k]]++] = lf.cluster;
-    }
-
-    // The clusters of the leafs a box touches (Quake 3's CM_BoxLeafnums: how the engine decides
-    // whether a brush entity is in the PVS). Each node is visited at most once.
-    auto boxClusters = [&](const Aabb &box, std::vector<int32_t> *clusters) {
-        if (level->leafs.empty()) return;
-        if (level->nodes.empty()) {
-            if (level->leafs[0].cluster >= 0) clusters->push_back(level->leafs[0].cluster);
-            return;
+        std::vector<uint32_t> fill(level->faceLeafsBegin.begin(), level->faceLeafsBegin.end() - 1);
+        for (size_t l = 0; l < nl; ++l) {
+            const BspLeaf &lf = level->leafs[l];
+            for (uint32_t k = 0; k < lf.leafFaceCount; ++k) level->faceLeafs[fill[level->leafFaces[lf.firstLeafFace + k]]++] = uint32_t(l);
         }
-        std::vector<uint8_t> seen(level->nodes.size(), 0);
-        std::vector<int32_t> stack{0};
-        while (!stack.empty()) {
-            const int32_t i = stack.back();
-            stack.pop_back();
-            if (i < 0) {
-                const int32_t c = level->leafs[size_t(-(i + 1))].cluster;
-                if (c >= 0) clusters->push_back(c);
-                continue;
-            }
-            if (seen[size_t(i)]) continue;
-            seen[size_t(i)] = 1;
-            const BspNode &n = level->nodes[size_t(i)];
-            const BspPlane &pl = level->planes[n.plane];
-            // The box's extreme distances to the plane: the corner furthest along +normal and -normal.
-            double lo = -pl.dist, hi = -pl.dist;
-            for (int a = 0; a < 3; ++a) {
-                const double x0 = pl.normal[a] * box.lo[a], x1 = pl.normal[a] * box.hi[a];
-                lo += std::min(x0, x1), hi += std::max(x0, x1);
-            }
-            if (hi >= 0) stack.push_back(n.children[0]);
-            if (lo < 0) stack.push_back(n.children[1]);
+    }
+    std::vector<uint32_t> owner(nf, kNone);
+    for (uint64_t f = 0; f < nf; ++f)
+        for (uint32_t k = level->faceLeafsBegin[f]; k < level->faceLeafsBegin[f + 1] && owner[f] == kNone; ++k)
+            if (level->leafInTree[level->faceLeafs[k]]) owner[f] = level->faceLeafs[k];
+    // The clusters of the leafs of the world's tree listing face f (a face straddling clusters is
+    // visible from any of them: keeping the union keeps the cells stage conservative).
+    auto faceClusters = [&](uint64_t f, std::vector<int32_t> *cl) {
+        for (uint32_t k = level->faceLeafsBegin[f]; k < level->faceLeafsBegin[f + 1]; ++k) {
+            const uint32_t l = level->faceLeafs[k];
+            if (level->leafInTree[l] && level->leafs[l].cluster >= 0) cl->push_back(level->leafs[l].cluster);
         }
     };
 
-    // The object list: leafs in order, then brush models 1.., then the unleafed world faces.
+    // The object list: leafs in order, then the drawn brush models 1.., then the unleafed world faces.
+    // A brush model's faces go to "modelK" whatever leafs list them; its clusters are those of the
+    // leafs its placed box reaches (BspModel::boxLeafs), the engine's own rule.
     struct Obj {
         std::string name;
         int32_t cluster = -1;
+        uint32_t model = 0;
         std::vector<uint32_t> faces;     // ascending
-        std::vector<int32_t> clusters;   // extra clusters (box clusters of a model)
     };
     std::vector<Obj> objs;
-    std::vector<uint32_t> leafObj(level->leafs.size(), kNone);
-    std::vector<uint32_t> modelObj(models.size(), kNone);
+    std::vector<uint32_t> leafObj(nl, kNone);
+    std::vector<uint32_t> modelObj(level->models.size(), kNone);
     uint32_t unleafedObj = kNone;
     for (uint64_t f = 0; f < nf; ++f) {
         if (kind[f] != kDrawn) continue;
         uint32_t *slot;
         std::string nm;
         int32_t cl = -1;
-        const uint32_t m = modelOf[f];
-        if (owner[f] != kNone) {
-            slot = &leafObj[owner[f]];
-            nm = "leaf" + str(owner[f]);
-            cl = level->leafs[owner[f]].cluster;
-        } else if (m != kNone && m > 0) {
+        const uint32_t m = modelOf[f] == kNone ? 0 : modelOf[f];
+        if (m > 0) {
             slot = &modelObj[m];
             nm = "model" + str(m);
             ++fc.modelFaces;
+        } else if (owner[f] != kNone) {
+            slot = &leafObj[owner[f]];
+            nm = "leaf" + str(owner[f]);
+            cl = level->leafs[owner[f]].cluster;
         } else {
             slot = &unleafedObj;
             nm = "unleafed";
@@ -598,8 +750,7 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         }
         if (*slot == kNone) {
             *slot = uint32_t(objs.size());
-            objs.push_back({nm, cl, {}, {}});
-            if (m != kNone && m > 0 && owner[f] == kNone) boxClusters(models[m].box, &objs.back().clusters);
+            objs.push_back({nm, cl, m, {}});
         }
         objs[*slot].faces.push_back(uint32_t(f));
     }
@@ -618,7 +769,9 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
     level->sourceCluster.clear();
     level->sourceClustersBegin.assign(1, 0);
     level->sourceClusters.clear();
+    level->sourceModel.clear();
     level->triangleFace.clear();
+    level->triangleFace.reserve(drawnTriangles);
     std::vector<Vec3> ctrl;
     for (uint32_t oi : order) {
         Obj &o = objs[oi];
@@ -626,33 +779,40 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         so.name = o.name;
         so.mesh = name_;
         RawMesh &m = so.geometry;
-        std::vector<int32_t> cl = o.clusters;
+        std::vector<int32_t> cl;
         if (o.cluster >= 0) cl.push_back(o.cluster);
+        static const BspModel kNoModel;
+        const BspModel &model = o.model < level->models.size() ? level->models[o.model] : kNoModel;
+        for (int32_t l : model.boxLeafs)
+            if (level->leafs[size_t(l)].cluster >= 0) cl.push_back(level->leafs[size_t(l)].cluster);
+        // A brush model is drawn where its entity puts it (BspModel::offset); the world at 0.
+        const Vec3 offset = model.offset;
         for (uint32_t fi : o.faces) {
             const Face &f = fs[fi];
-            cl.insert(cl.end(), faceClusters.begin() + faceBegin[fi], faceClusters.begin() + faceBegin[fi + 1]);
+            faceClusters(fi, &cl);
             ++m.facesRead;
+            const size_t trianglesBefore = m.indices.size() / 3;
             if (f.type == kPatch) {
                 ctrl.resize(size_t(f.width) * size_t(f.height));
-                for (size_t k = 0; k < ctrl.size(); ++k) ctrl[k] = position(uint64_t(f.vertex) + k);
-                const size_t before = m.indices.size() / 3;
+                for (size_t k = 0; k < ctrl.size(); ++k) ctrl[k] = position(uint64_t(f.vertex) + k) + offset;
                 tessellatePatch(ctrl, f.width, f.height, L, &m);
-                level->triangleFace.insert(level->triangleFace.end(), m.indices.size() / 3 - before, fi);
-                continue;
+            } else {
+                // Polygons and meshes: meshverts index the face's own vertices (offset by its first
+                // vertex); each triangle is stored clockwise seen from the front, so two corners swap.
+                const uint32_t base = uint32_t(m.positions.size());
+                for (int32_t k = 0; k < f.nVertexes; ++k)
+                    m.positions.push_back(position(uint64_t(f.vertex) + uint64_t(k)) + offset);
+                for (int32_t k = 0; k < f.nMeshverts; k += 3) {
+                    const uint8_t *mv = rec(kMeshVerts, uint64_t(f.meshvert) + uint64_t(k));
+                    const uint32_t a = u32(mv), b = u32(mv + 4), c = u32(mv + 8);
+                    m.indices.insert(m.indices.end(), {base + a, base + c, base + b});
+                }
             }
-            level->triangleFace.insert(level->triangleFace.end(), size_t(f.nMeshverts / 3), fi);
-            // Polygons and meshes: meshverts index the face's own vertices (offset by its first
-            // vertex); each triangle is stored clockwise seen from the front, so two corners swap.
-            const uint32_t base = uint32_t(m.positions.size());
-            for (int32_t k = 0; k < f.nVertexes; ++k) m.positions.push_back(position(uint64_t(f.vertex) + uint64_t(k)));
-            for (int32_t k = 0; k < f.nMeshverts; k += 3) {
-                const uint8_t *mv = rec(kMeshVerts, uint64_t(f.meshvert) + uint64_t(k));
-                const uint32_t a = u32(mv), b = u32(mv + 4), c = u32(mv + 8);
-                m.indices.insert(m.indices.end(), {base + a, base + c, base + b});
-            }
+            level->triangleFace.insert(level->triangleFace.end(), m.indices.size() / 3 - trianglesBefore, fi);
         }
         std::sort(cl.begin(), cl.end());
         cl.erase(std::unique(cl.begin(), cl.end()), cl.end());
+        level->sourceModel.push_back(o.model);
         level->sourceCluster.push_back(o.cluster);
         level->sourceClusters.insert(level->sourceClusters.end(), cl.begin(), cl.end());
         level->sourceClustersBegin.push_back(uint32_t(level->sourceClusters.size()));
@@ -667,6 +827,13 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
                                 " sky, " + str(int64_t(fc.nodraw)) + " nodraw, " + str(int64_t(fc.nonSolid)) +
                                 " non-solid see-through, " + str(int64_t(fc.billboards)) + " billboard and " +
                                 str(int64_t(fc.bad)) + " bad faces");
+    if (fc.notDrawnEntity > 0) {
+        uint64_t entities = 0;
+        for (const BspModel &md : level->models) entities += md.notDrawnFaces > 0;
+        out->warnings.push_back(name_ + ": not geometry (docs/quake3.md, \"Brush entities\"): " +
+                                str(int64_t(fc.notDrawnEntity)) + " faces of " + str(int64_t(entities)) +
+                                " brush entities the engine never draws (trigger_*, models no entity spawns)");
+    }
     return true;
 }
 

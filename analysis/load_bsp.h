@@ -24,6 +24,8 @@ struct BspOptions {
                                          //   2 * level^2 triangles per patch; --patch-level
     uint64_t maxTriangles = 50'000'000;  // refused before allocating when the faces would make more
     uint64_t maxFileBytes = 1ull << 30;  // a .bsp (or .pk3 member) larger than this is refused unread
+    uint64_t maxBoxWalkSteps = 1ull << 27;  // nodes the brush models' box walks may visit, all together:
+                                            //   a real map's visit well under a million; above, refused
 };
 
 // True for "x.bsp" and "x.pk3:maps/y.bsp" (extensions case-insensitive).

@@ -141,7 +141,11 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             }
             st.ms = t0.ms();
             st.ran = true;
-            if (s.audit) culls.push_back({"cells", removed(objects, visible), {}});
+            if (s.audit) {
+                culls.push_back({"cells", removed(objects, visible), {}});
+                // A map's PVS leaves out on purpose what lies beyond its designed far plane.
+                if (!hasPortals && scene.bsp) culls.back().designFarPlane = scene.bsp->farPlane.distance;
+            }
             objects = std::move(visible);
             st.trianglesOut = trianglesOf(scene, objects);
             st.trianglesCulled = st.trianglesIn - st.trianglesOut;
@@ -292,7 +296,6 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         opt.tiesToLowestId = true;
         opt.keepBarycentrics = ps.effects.tracesRays();
         r.raycastImage = ps.rays->castPrimary(cam, opt, &r.raycast);
-        st.ms = t0.ms();
         st.ran = true;
         r.raycastRan = true;
         st.trianglesIn = scene.objectTriangles.size();
@@ -304,9 +307,27 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
             }
         // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
         st.trianglesCulled = st.trianglesIn - st.trianglesOut;
+        // Like with like: the z-buffer drew only what the culling stages kept (lists.triangles). Where
+        // the whole-scene rays hit a triangle outside that set, cast again over the set itself, so
+        // that a cull (judged by the culling audit) is never also counted as a disagreement.
+        std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
+        for (uint32_t t : lists.triangles) outOfSet[t] = 0;
+        uint64_t culledPixels = 0;
+        for (uint32_t id : r.raycastImage.id) culledPixels += id && outOfSet[id - 1];
+        RaycastImage sameSet;
+        if (culledPixels > 0) {
+            PrimaryOptions same = opt;
+            same.keepBarycentrics = false;
+            same.rejectSource = outOfSet.data();
+            sameSet = ps.rays->castPrimary(cam, same, nullptr);
+        }
+        st.ms = t0.ms();
         r.stages.push_back(st);
-        r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, r.raycastImage.id, r.raycastImage.depth, scene, cam,
+        const RaycastImage &compared = culledPixels > 0 ? sameSet : r.raycastImage;
+        r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, cam,
                                   makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ), ps.rays->origin());
+        r.crossCheck.culled = culledPixels;
+        r.crossCheck.recast = culledPixels > 0;
         if (ps.effects.tracesRays() && !stopped()) {
             r.effects = traceEffects(*ps.rays, cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
             r.effectsRan = true;
@@ -325,7 +346,12 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         const uint64_t pixels = uint64_t(std::max(cam.width, 0)) * uint64_t(std::max(cam.height, 0));
         const uint64_t cache = ps.bspTree ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
         r.reference = referenceVisibility(scene, cam, cache);
-        r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource);
+        r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource, &cam);
+        // A map's PVS: the evidence of each false cull it made (camera leaf and cluster, faces, leafs,
+        // clusters, PVS bits, distances), for a reader to check against the map's bytes.
+        if (hasPvs && !hasPortals && s.cells)
+            for (size_t k = 0; k < culls.size(); ++k)
+                if (culls[k].stage == "cells") r.pvsEvidence = pvsEvidence(scene, cam, r.cells, r.reference, r.cullAudit, k);
         r.auditMs = t0.ms();
         r.auditRan = true;
     } else {
@@ -381,7 +407,9 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
               uint64_t(scene.objects.size()) * (sizeof(SceneObject) + 32) +
               uint64_t(scene.sources.size()) * (sizeof(SourceObject) + 64);
     if (scene.bsp) m.scene += bytesOf(scene.bsp->pvs) + bytesOf(scene.bsp->leafFaces) + bytesOf(scene.bsp->nodes) +
-                              bytesOf(scene.bsp->leafs) + bytesOf(scene.bsp->planes);
+                              bytesOf(scene.bsp->leafs) + bytesOf(scene.bsp->planes) +
+                              bytesOf(scene.bsp->triangleFace) + bytesOf(scene.bsp->faceLeafs) +
+                              bytesOf(scene.bsp->faceLeafsBegin);
 
     // Built once: the object BVH and grid (per object), Embree's float copy and BVH (about 100
     // bytes per triangle with the build's temporaries), per-triangle effect data, the ordering
@@ -403,7 +431,7 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     //   writing images (one 8-bit RGBA or float image at a time, and the PNG encoder)   16
     uint64_t perPixel = 20 + 16;
     if (s.audit) perPixel += 13;
-    if (s.raycast) perPixel += 9;
+    if (s.raycast) perPixel += 17;  // + the cross-check's recast over the z-buffer's set (id, depth)
     if (s.zfight) perPixel += 33;
     const EffectPlan plan = planEffects(scene, s.effects);
     if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;
@@ -517,6 +545,19 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         b.patchLevel = scene.bsp->patchLevel;
         b.hasPvs = scene.bsp->hasPvs();
         b.spawnPoints = spawnViews(scene).size();
+        for (size_t k = 1; k < scene.bsp->models.size(); ++k) {
+            const BspModel &m = scene.bsp->models[k];
+            if (m.drawn) {
+                b.drawnBrushEntities += m.entity >= 0;
+                continue;
+            }
+            ++b.notDrawnBrushEntities;
+            if (m.notDrawnFaces > 0)
+                b.notDrawn.push_back({uint32_t(k), m.entity, m.classname, m.entity >= 0 ? "trigger" : "no entity",
+                                      m.notDrawnFaces, m.notDrawnTriangles});
+        }
+        b.farPlane = scene.bsp->farPlane;
+        b.fogShader = scene.bsp->fogShader;
         out->bsp = b;
     }
     std::mutex errMutex;

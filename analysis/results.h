@@ -15,6 +15,7 @@
 #include "analysis/occlusion.h"
 #include "analysis/ordering.h"
 #include "analysis/portals.h"
+#include "analysis/pvs_evidence.h"
 #include "analysis/effects_plan.h"
 #include "analysis/scene.h"
 #include "analysis/zfight.h"
@@ -89,6 +90,7 @@ struct ViewResult {
     std::string auditReason;          // why it did not run
     ReferenceVisibility reference;
     CullAudit cullAudit;
+    PvsEvidence pvsEvidence;          // a map's PVS: the evidence of its false culls (pvs_evidence.h)
     double auditMs = 0;
     bool zfightRan = false;           // the per-view z-fighting analysis (docs/zfighting.md)
     std::string zfightReason;         // why it did not run
@@ -147,6 +149,20 @@ struct AnalysisResult {
         int patchLevel = 0;
         bool hasPvs = false;
         uint64_t spawnPoints = 0;     // views --views spawns makes (spawn and intermission points)
+        // Brush entities the engine never draws (docs/quake3.md, "Brush entities"): every one whose
+        // model has faces with geometry, in model order; their faces are not geometry.
+        struct NotDrawn {
+            uint32_t model = 0;       // K of "*K"
+            int32_t entity = -1;      // index in the entity lump; -1: no entity spawns the model
+            std::string classname;    // "" when no entity
+            std::string reason;       // "trigger" (trigger_* entities) or "no entity"
+            uint64_t faces = 0, triangles = 0;
+        };
+        std::vector<NotDrawn> notDrawn;
+        uint64_t drawnBrushEntities = 0;   // brush models 1.. some entity spawns and the engine draws
+        uint64_t notDrawnBrushEntities = 0;// brush models 1.. never drawn (with or without faces)
+        BspFarPlane farPlane;         // the map's designed far plane (distance 0: none)
+        std::string fogShader;        // worldspawn "_fog" / "fog" ("" none)
     };
     std::optional<BspSummary> bsp;
     bool raycast = false;             // whether the raycast stage ran

@@ -119,7 +119,8 @@ struct BspBrush {
 };
 
 // What the map's faces were, counted by kind (a face counts once, under the first rule that holds:
-// bad type, billboard, sky, nodraw, non-solid, else drawn by type).
+// bad type, billboard, a brush entity the engine never draws, sky, nodraw, non-solid, else drawn by
+// type).
 struct BspFaceCounts {
     uint64_t faces = 0;         // faces in the file
     uint64_t polygons = 0;      // drawn type-1 faces (planar polygons, triangles from meshverts)
@@ -127,13 +128,47 @@ struct BspFaceCounts {
     uint64_t meshes = 0;        // drawn type-3 faces (triangle soups: models baked into the map)
     uint64_t billboards = 0;    // type-4 faces (flares: a point, no geometry), skipped
     uint64_t bad = 0;           // type-0 faces (MST_BAD: no geometry), skipped
+    uint64_t notDrawnEntity = 0;// faces of brush models the engine never draws (a trigger_* entity's, or a
+                                //   model no entity spawns): not geometry, excluded (BspModel lists them)
     uint64_t sky = 0;           // SURF_SKY (0x4): the sky box, excluded from objects
-    uint64_t nodraw = 0;        // SURF_NODRAW (0x80), SURF_HINT (0x100), SURF_SKIP (0x200): never drawn, excluded
+    uint64_t nodraw = 0;        // tool surfaces: SURF_NODRAW (0x80), SURF_HINT (0x100), SURF_SKIP (0x200), or
+                                //   CONTENTS_AREAPORTAL (0x8000): never drawn, excluded
     uint64_t nonSolid = 0;      // water, slime, lava, fog volumes (contents 0x8/0x10/0x20/0x40): excluded
     uint64_t polygonTriangles = 0, patchTriangles = 0, meshTriangles = 0;  // triangles of drawn faces by type
     uint64_t skyTriangles = 0, nodrawTriangles = 0, nonSolidTriangles = 0;  // triangles of excluded faces
-    uint64_t unleafedFaces = 0; // drawn world faces no leaf references (object "unleafed", no cluster)
-    uint64_t modelFaces = 0;    // drawn faces of brush models 1.. (doors, platforms): objects "modelK"
+    uint64_t notDrawnEntityTriangles = 0;  // triangles of the notDrawnEntity faces
+    uint64_t unleafedFaces = 0; // drawn world faces no leaf of the world's tree lists (object "unleafed", no cluster)
+    uint64_t modelFaces = 0;    // drawn faces of brush models 1.. the engine draws (doors, platforms, movers):
+                                //   objects "modelK", clustered by their box through the world's tree
+};
+
+// A brush model (the models lump; model 0 is the world) and the entity the game spawns for it.
+struct BspModel {
+    Aabb bounds;                 // as stored, moved by `offset` (where the game draws it)
+    Vec3 offset;                 // the placing entity's "origin" (a func_train: its first path_corner's,
+                                 //   where it starts); 0 for the world and entities without one
+    int32_t entity = -1;         // the first entity with "model" "*K" (index into BspLevel::entities);
+                                 //   -1: none (always for model 0)
+    std::string classname;       // that entity's classname ("" when none)
+    bool drawn = true;           // false: the engine never draws it: a trigger_* entity (the game sends
+                                 //   triggers to no client, or the client draws nothing for them), or no
+                                 //   entity spawns the model
+    uint32_t firstFace = 0, faceCount = 0;  // its faces in the faces lump
+    uint64_t notDrawnFaces = 0, notDrawnTriangles = 0;  // !drawn: its faces with geometry (not bad or
+                                 //   billboard: BspFaceCounts::notDrawnEntity), and their triangles
+    // K >= 1: the leafs its box (`bounds` widened by 1 unit per side, as the server links entities)
+    // reaches walking the world's tree, as the engine's CM_BoxLeafnums: the leafs whose clusters
+    // decide whether the entity is in the PVS. Ascending. Empty for the world.
+    std::vector<int32_t> boxLeafs;
+};
+
+// The map's designed far plane: the worldspawn key q3map2's vis reads ("_farplanedist", or Wolfenstein's
+// "fogclip", Soldier of Fortune 2's "distancecull"), a distance and an optional mode letter. Portal
+// pairs farther apart than it are left out of the PVS on purpose (docs/quake3.md, "The far plane").
+struct BspFarPlane {
+    double distance = 0;         // > 0: the map has one
+    char mode = 0;               // q3map2's mode letter after the number: 'o', 'e', 'r'; 0: default rule
+    std::string key, value;      // the key that set it and its text
 };
 
 // A Quake 3 map's visibility structure. Present only for scenes loaded from a .bsp.
@@ -162,6 +197,16 @@ struct BspLevel {
     std::vector<uint32_t> faceShader;
     uint32_t worldFirstFace = 0, worldFaceCount = 0;
     std::vector<uint32_t> triangleFace;
+    std::vector<BspModel> models;           // every model; [0] is the world
+    std::vector<uint8_t> leafInTree;        // per leaf: 1 when the world's tree reaches it (the models'
+                                            //   own leafs, cluster 0 with zero bounds, it never reaches)
+    // Every leaf listing each face (the leaffaces lump inverted, ascending per face):
+    // faceLeafs[faceLeafsBegin[f] .. faceLeafsBegin[f + 1]).
+    std::vector<uint32_t> faceLeafsBegin, faceLeafs;
+    std::vector<uint32_t> sourceModel;      // per source object: its model (0: world faces)
+    BspFarPlane farPlane;
+    std::string fogShader;                  // worldspawn "_fog" / "fog": a map-wide fog shader (q3map2; not
+                                            //   drawn by ioquake3, its range is in a shader script)
     BspFaceCounts faceCounts;
     int patchLevel = 0;                     // the tessellation level used (segments per patch edge)
 

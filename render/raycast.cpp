@@ -395,6 +395,14 @@ RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt,
         rc.reject = reject.data();
         rc.ctx.filter = primaryFilter;
     }
+    if (opt.rejectSource) {
+        // Triangles outside the cast's set: rejected like back faces.
+        const size_t prims = m.primToSource.size();
+        if (reject.empty()) reject.assign(prims, 0);
+        for (size_t k = 0; k < prims; ++k) reject[k] |= opt.rejectSource[m.primToSource[k]] ? 1 : 0;
+        rc.reject = reject.data();
+        rc.ctx.filter = primaryFilter;
+    }
     if (opt.tiesToLowestId && !m.primToSource.empty()) {
         rc.primToSource = m.primToSource.data();
         rc.ctx.filter = primaryFilter;

@@ -60,6 +60,10 @@ struct PrimaryOptions {
     bool tiesToLowestId = false;
     // Fill RaycastImage::u and v (render/effects.h needs them).
     bool keepBarycentrics = false;
+    // Per source triangle: nonzero = not in this cast's triangle set (hits on it are rejected, the
+    // ray goes on to what lies behind). Null: every triangle of the scene. The cross-check casts the
+    // z-buffer's own triangle set this way (docs/audits.md, "Like with like").
+    const uint8_t *rejectSource = nullptr;
 };
 
 // A single ray in the scene's float frame (world position minus RayScene::origin()).

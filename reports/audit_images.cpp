@@ -64,6 +64,8 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
                 c = kCullUnaccounted;
             } else if (f == kFateSnapped) {
                 c = kCullSnapped;
+            } else if (f == kFateBeyondFarPlane) {
+                c = kCullBeyondFarPlane;
             } else if (f >= kFateCulledFirst) {
                 c = cullStageColor(f - kFateCulledFirst);
             }
@@ -76,6 +78,9 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
     uint64_t snapped = 0;
     for (const StageCullAudit &s : audit.stages) snapped += s.snappedPixels;
     if (snapped) legend.push_back({kCullSnapped, "snapped sliver (" + std::to_string(snapped) + " px)"});
+    if (audit.beyondFarPlanePixels)
+        legend.push_back({kCullBeyondFarPlane, "beyond the map's far plane, by design (" +
+                                                   std::to_string(audit.beyondFarPlanePixels) + " px)"});
     if (audit.unaccountedPixels) legend.push_back({kCullUnaccounted, "unaccounted"});
     int CH = 0;
     const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);

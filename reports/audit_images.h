@@ -32,6 +32,7 @@ Rgb8 cullStageColor(size_t stage);
 constexpr Rgb8 kCullDrawnTint{255, 255, 255};  // multiplied by the depth gray
 constexpr Rgb8 kCullUnaccounted{255, 0, 255};
 constexpr Rgb8 kCullSnapped{150, 150, 200};  // culled by facing, shown only as a snapped sliver
+constexpr Rgb8 kCullBeyondFarPlane{0, 120, 120};  // culled beyond the map's design far plane: by design
 Rgb8 disagreementColor(Disagreement d);  // none: black (not used: the dimmed image shows)
 
 // BASE.culling.png from a view's reference and culling audit.

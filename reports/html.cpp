@@ -908,6 +908,7 @@ struct HtmlWriter {
     void header(const std::vector<ViewScore> &worstFirst);
     void summary(const std::vector<ViewScore> &worstFirst);
     void planner();
+    void quakeMap();
     void depthAuditImage();
     void pvsAuditLink();
     void view(const Json *v, size_t pos);
@@ -916,6 +917,7 @@ struct HtmlWriter {
     void images(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs, bool eager);
     void hotspots(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
     void falseCulls(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
+    void pvsEvidence(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
     void raycast(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs);
     void depthFormats(const Json *v, const std::string &id);
     void accuracy(const Json *v, const std::string &id,
@@ -1029,6 +1031,49 @@ void HtmlWriter::planner() {
         }
     if (!line.empty()) o += "<p id=\"planner-decisions\">" + line + "</p>";
     o += "<details><summary>all values</summary>" + genericJson(fx) + "</details></section>";
+}
+
+// A Quake 3 map's structure: clusters, the designed far plane, and the brush entities the engine
+// never draws (docs/quake3.md, "Brush entities" and "The far plane").
+void HtmlWriter::quakeMap() {
+    const Json *b = get(&report, {"scene", "bsp"});
+    if (!b || !b->is_object()) return;
+    o += "<section class=\"block\" id=\"quake-map\"><h2>Quake 3 map</h2><p>" + fmtCount(numOr(b, {"leafs"}, 0)) +
+         " leafs in " + fmtCount(numOr(b, {"clusters"}, 0)) + " clusters, " +
+         (isTrue(get(b, "has_pvs")) ? "with a PVS" : "<b>no PVS</b> (compiled without vis)") + "; " +
+         plural(numOr(b, {"brush_entities_drawn"}, 0), "drawn brush entity", "drawn brush entities") + " (" +
+         plural(numOr(b, {"model_faces"}, 0), "face", "faces") +
+         ", clustered by their box through the world's tree).</p>";
+    const Json *fp = get(b, "far_plane");
+    if (fp && fp->is_object())
+        o += "<p id=\"far-plane\">Designed far plane: <code>" + esc(str(get(fp, "key"))) + " " + esc(str(get(fp, "value"))) +
+             "</code> = " + fmtReal(numOr(fp, {"distance"}, 0)) +
+             " units. The compiler leaves portal pairs farther apart out of the PVS on purpose: views made from the map "
+             "use it as their far plane, and a surface the PVS leaves out that lies farther than it from the eye is "
+             "reported as hidden by design, not as a false cull.</p>";
+    else
+        o += "<p id=\"far-plane\" class=\"note\">No designed far plane (<code>_farplanedist</code>).</p>";
+    o += "<h3 id=\"not-drawn-entities\">Brush entities the engine never draws (not geometry)</h3>";
+    const Json *nd = get(b, "not_drawn_entities");
+    const double ndCount = numOr(b, {"brush_entities_not_drawn"}, 0);
+    if (nd && nd->is_array() && !nd->empty()) {
+        o += "<p>" + plural(numOr(b, {"not_drawn_entity_faces"}, 0), "face", "faces") + " (" +
+             plural(numOr(b, {"not_drawn_entity_triangles"}, 0), "triangle", "triangles") + ") of " +
+             plural(ndCount, "brush entity", "brush entities") +
+             " the game never draws (triggers, models no entity spawns) are kept out of the scene:</p>";
+        o += "<div class=\"scroll\"><table id=\"not-drawn-table\"><tr><th class=\"n\">model</th><th class=\"n\">entity</th>"
+             "<th>classname</th><th>why</th><th class=\"n\">faces</th><th class=\"n\">triangles</th></tr>";
+        for (const Json &e : *nd)
+            o += "<tr><td class=\"n\">*" + fmtValue(get(&e, "model")) + "</td><td class=\"n\">" + fmtValue(get(&e, "entity")) +
+                 "</td><td>" + esc(str(get(&e, "classname"))) + "</td><td>" + esc(str(get(&e, "reason"))) +
+                 "</td><td class=\"n\">" + fmtValue(get(&e, "faces")) + "</td><td class=\"n\">" +
+                 fmtValue(get(&e, "triangles")) + "</td></tr>";
+        o += "</table></div>";
+    } else {
+        o += "<p class=\"note\">" + plural(ndCount, "brush entity", "brush entities") +
+             " the game never draws, none with faces.</p>";
+    }
+    o += "</section>\n";
 }
 
 void HtmlWriter::depthAuditImage() {
@@ -1264,12 +1309,124 @@ void HtmlWriter::falseCulls(const Json *v, const std::string &id, const std::vec
             o += "<p class=\"note\">Not counted above: " + plural(snappedTris, "back-facing sliver", "back-facing slivers") +
                  " (" + plural(snappedPx, "pixel", "pixels") + ") culled rightly by the backface stage: the reference "
                  "sees a front winding only because snapping to the 1/256-pixel grid flipped it.</p>";
+        for (auto it = byStage->begin(); it != byStage->end(); ++it) {
+            const Json *st = &it.value();
+            const double bpx = numOr(st, {"beyond_far_plane_pixels"}, 0);
+            if (bpx <= 0) continue;
+            o += "<p class=\"note\" id=\"" + id + "-beyond\">Not counted above: " + plural(bpx, "pixel", "pixels") +
+                 " of surfaces the " + esc(it.key()) + " stage left out lie beyond the map's far plane (" +
+                 fmtReal(numOr(st, {"design_far_plane"}, 0)) + " units; the nearest " +
+                 fmtReal(numOr(st, {"beyond_far_plane_nearest"}, 0)) +
+                 " units from the eye): hidden by design, as the compiler's distance rule leaves them out (" +
+                 plural(numOr(st, {"beyond_far_plane_triangles"}, 0), "triangle", "triangles") +
+                 " visible only there).</p>";
+        }
     }
+    pvsEvidence(v, id, imgs);
     if (const Json *w = get(a, "wasted_draws"); w && w->is_object())
         o += "<p>Wasted draws: " + fmtCount(numOr(w, {"triangles"}, 0)) + " of " + fmtCount(numOr(w, {"drawn_triangles"}, 0)) +
              " drawn triangles (" + pct(numOr(w, {"share"}, 0), 1) + ") and " + fmtCount(numOr(w, {"objects"}, 0)) + " of " +
              fmtCount(numOr(w, {"drawn_objects"}, 0)) + " drawn objects are visible nowhere; they cost " +
              fmtCount(numOr(w, {"fragments"}, 0)) + " of " + fmtCount(numOr(w, {"drawn_fragments"}, 0)) + " fragments.</p>";
+}
+
+// An index (leaf, cluster, face, object) as written, without thousands separators; "—" if absent.
+std::string rawInt(const Json *j) {
+    if (!j || !j->is_number_integer()) return "—";
+    return j->is_number_unsigned() ? std::to_string(j->get<uint64_t>()) : std::to_string(j->get<int64_t>());
+}
+
+// The evidence of the PVS's false culls (audit.pvs_evidence; docs/quake3.md, "Reading the evidence"),
+// next to the culling-fates image with a box on each face's nearest pixel.
+void HtmlWriter::pvsEvidence(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs) {
+    const Json *e = get(v, {"audit", "pvs_evidence"});
+    const Json *objs = get(e, "objects");
+    if (!objs || !objs->is_array() || objs->empty()) return;
+    o += "<h4 id=\"" + id + "-evidence\">Evidence of the PVS's false culls</h4><p>The eye is in leaf " +
+         rawInt(get(e, "camera_leaf")) + ", cluster <b>" + rawInt(get(e, "camera_cluster")) +
+         "</b>. Each face below is visible in the reference, yet every cluster of its object has bit 0 in that "
+         "cluster's PVS row: the map's PVS says the eye cannot see it. Each leaf listing the face is shown with its "
+         "cluster and that bit (a leaf the world's tree never reaches is a brush model's own); a brush model's "
+         "clusters are those of the leafs its box reaches. Distances are from the eye to the nearest visible point";
+    if (const auto fp = num(get(e, "design_far_plane"))) o += ", all within the map's far plane of " + fmtReal(*fp);
+    o += ".";
+    if (const auto om = num(get(e, "objects_omitted")); om && *om > 0)
+        o += " " + plural(*om, "more object is", "more objects are") + " left out (the list keeps the worst " +
+             std::to_string(objs->size()) + ").";
+    o += "</p><div class=\"evidence\">";
+    const ViewImage *cull = findImage(imgs, "culling");
+    if (cull) {
+        o += "<figure id=\"" + id + "-ev-img\"><a class=\"enlarge imgwrap\" href=\"" + urlOf(cull->file) +
+             "\" data-title=\"" + esc(cull->title + " — " + cull->file) + "\"><img src=\"" + urlOf(cull->file) +
+             "\" alt=\"" + esc(cull->title) + "\" loading=\"lazy\"";
+        if (cull->width > 0)
+            o += " width=\"" + std::to_string(cull->width) + "\" height=\"" + std::to_string(cull->height) + "\"";
+        o += ">";
+        size_t k = 0;
+        for (const Json &ob : *objs)
+            if (const Json *fs = get(&ob, "faces"); fs && fs->is_array())
+                for (const Json &f : *fs) {
+                    ++k;
+                    const Json *px = get(&f, "pixel");
+                    if (px && px->is_array() && px->size() == 2 && (*px)[0].is_number() && (*px)[1].is_number())
+                        o += highlightBox(id + "-ev" + std::to_string(k), *cull, (*px)[0].get<double>() - 4,
+                                          (*px)[1].get<double>() - 4, (*px)[0].get<double>() + 4,
+                                          (*px)[1].get<double>() + 4, "face " + rawInt(get(&f, "face")));
+                }
+        o += "</a><figcaption><b>" + esc(cull->title) + "</b> <code>" + esc(cull->file) + "</code></figcaption></figure>";
+    }
+    o += "<div class=\"scroll\"><table class=\"evidence-table\"><tr><th>object</th><th>its clusters (PVS bit)</th>"
+         "<th>face</th><th class=\"n\">px</th><th class=\"n\">nearest</th><th>leafs listing the face: cluster, PVS bit</th></tr>";
+    auto leafList = [&](const Json *ls, const Json *omitted) {
+        std::string t;
+        if (ls && ls->is_array())
+            for (const Json &l : *ls) {
+                const Json *bit = get(&l, "pvs_bit");
+                t += (t.empty() ? "" : "; ") + std::string("leaf ") + rawInt(get(&l, "leaf")) + ": " +
+                     (num(get(&l, "cluster")).value_or(-1) < 0 ? std::string("no cluster")
+                                                               : "cluster " + rawInt(get(&l, "cluster")) + ", bit " +
+                                                                     (bit && bit->is_number() ? fmtValue(bit) : "—")) +
+                     (isTrue(get(&l, "in_tree")) ? "" : " (not in the tree)");
+            }
+        if (const auto om = num(omitted); om && *om > 0) t += " … " + fmtCount(*om) + " more";
+        return t.empty() ? std::string("<span class=\"muted\">none</span>") : esc(t);
+    };
+    size_t k = 0;
+    for (const Json &ob : *objs) {
+        const Json *fs = get(&ob, "faces");
+        const size_t rows = fs && fs->is_array() && !fs->empty() ? fs->size() : 1;
+        std::string clusters;
+        if (const Json *cs = get(&ob, "clusters"); cs && cs->is_array())
+            for (const Json &c : *cs)
+                clusters += (clusters.empty() ? "" : ", ") + rawInt(get(&c, "cluster")) + " (" + fmtValue(get(&c, "pvs_bit")) + ")";
+        if (const auto om = num(get(&ob, "clusters_omitted")); om && *om > 0) clusters += " … " + fmtCount(*om) + " more";
+        std::string who = "<b>" + esc(str(get(&ob, "name"))) + "</b> (#" + rawInt(get(&ob, "object")) + ")<br>" +
+                          plural(numOr(&ob, {"triangles"}, 0), "triangle", "triangles") + ", " +
+                          plural(numOr(&ob, {"pixels"}, 0), "pixel", "pixels");
+        if (numOr(&ob, {"model"}, 0) > 0)
+            who += "<br>model *" + rawInt(get(&ob, "model")) + " " + esc(str(get(&ob, "classname"))) +
+                   "; box leafs: " + leafList(get(&ob, "box_leafs"), get(&ob, "box_leafs_omitted"));
+        if (const auto om = num(get(&ob, "faces_omitted")); om && *om > 0)
+            who += "<br>" + plural(*om, "more face", "more faces") + " not listed";
+        o += "<tr><td rowspan=\"" + std::to_string(rows) + "\">" + who + "</td><td rowspan=\"" + std::to_string(rows) +
+             "\">" + (clusters.empty() ? "<span class=\"muted\">none</span>" : esc(clusters)) + "</td>";
+        if (!fs || !fs->is_array() || fs->empty()) {
+            o += "<td colspan=\"4\" class=\"muted\">no face recorded</td></tr>";
+            continue;
+        }
+        bool first = true;
+        for (const Json &f : *fs) {
+            ++k;
+            if (!first) o += "<tr>";
+            first = false;
+            std::string face = "face " + rawInt(get(&f, "face"));
+            if (cull) face = "<a class=\"px\" href=\"#" + id + "-ev" + std::to_string(k) + "\">" + face + "</a>";
+            o += "<td>" + face + "</td><td class=\"n\">" + fmtValue(get(&f, "pixels")) + "</td><td class=\"n\">" +
+                 fmtReal(numOr(&f, {"nearest"}, 0)) + "</td><td>" + leafList(get(&f, "leafs"), get(&f, "leafs_omitted")) +
+                 "</td></tr>";
+        }
+    }
+    o += "</table></div></div>";
 }
 
 void HtmlWriter::raycast(const Json *v, const std::string &id, const std::vector<ViewImage> &imgs) {
@@ -1289,6 +1446,12 @@ void HtmlWriter::raycast(const Json *v, const std::string &id, const std::vector
                 o += std::string("<tr><td>") + label(k) + "</td><td class=\"n" + (std::string(k) == "genuine" && *n > 0 ? " bad" : "") +
                      "\">" + fmtCount(*n) + "</td><td class=\"n\">" + pct(*n, px) + "</td></tr>";
         o += "</table></div>";
+        if (const auto culled = num(get(cc, "culled")); culled && *culled > 0)
+            o += "<p class=\"note\" id=\"" + id + "-culled\">Compared like with like: at " + plural(*culled, "pixel", "pixels") +
+                 " the ray caster over the whole scene hits a triangle a culling stage removed; the culling audit judges "
+                 "those (false culls, hidden by design), and there the z-buffer was compared with the ray caster over "
+                 "its own triangles. A genuine disagreement is one renderer disagreeing with the other on the same "
+                 "triangles: 0 means no renderer bug.</p>";
         const Json *ex = get(cc, "genuine_examples");
         const ViewImage *diff = findImage(imgs, "raycast");
         if (ex && ex->is_array() && !ex->empty()) {
@@ -1469,6 +1632,7 @@ std::string reportHtml(const nlohmann::ordered_json &report, const std::string &
     w.header(worstFirst);
     w.summary(worstFirst);
     w.planner();
+    w.quakeMap();
     if (const Json *scene = get(&report, "scene"))
         o += "<section class=\"block\" id=\"scene\"><h2>Scene</h2><details><summary>as loaded</summary>" + genericJson(scene) +
              "</details></section>\n";

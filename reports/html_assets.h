@@ -89,6 +89,8 @@ dialog img { max-width: 92vw; max-height: 88vh; display: block; }
 dialog p { margin: 4px 0 0; }
 details > summary { cursor: pointer; color: var(--muted); }
 .swatch { display: inline-block; width: 10px; height: 10px; margin-right: 4px; vertical-align: baseline; }
+.evidence { display: grid; grid-template-columns: minmax(280px, 2fr) 3fr; gap: 14px; align-items: start; }
+@media (max-width: 900px) { .evidence { grid-template-columns: 1fr; } }
 )CSS";
 
 inline constexpr const char *kScript = R"JS(

@@ -344,6 +344,8 @@ Json raycastJson(const ViewResult &v, const std::vector<std::string> &lightNames
                         {"tie", c.tie},
                         {"genuine", c.genuine},
                         {"one_sided_background", c.oneSidedBackground},
+                        {"culled", c.culled},
+                        {"recast", c.recast},
                         {"max_relative_depth_difference", num(c.maxRelativeDepthDifference)},
                         {"genuine_examples", examples},
                         {"ms", num(c.ms)}};
@@ -412,6 +414,57 @@ Json cameraJson(const CameraSpec &c) {
     return j;
 }
 
+// The evidence of a map's PVS false culls (analysis/pvs_evidence.h; docs/quake3.md, "Reading the
+// evidence"). Bounded by the kEvidence* limits; every list says what it left out.
+Json pvsEvidenceJson(const PvsEvidence &e) {
+    auto leafs = [](const std::vector<PvsLeafBit> &ls) {
+        Json a = Json::array();
+        for (const PvsLeafBit &l : ls)
+            a.push_back({{"leaf", l.leaf},
+                         {"cluster", l.cluster},
+                         {"in_tree", l.inTree},
+                         {"pvs_bit", l.pvsBit < 0 ? Json(nullptr) : Json(l.pvsBit)}});
+        return a;
+    };
+    Json objects = Json::array();
+    for (const PvsObjectEvidence &o : e.objects) {
+        Json clusters = Json::array();
+        for (const PvsClusterBit &c : o.clusters) clusters.push_back({{"cluster", c.cluster}, {"pvs_bit", c.pvsBit}});
+        Json faces = Json::array();
+        for (const PvsFaceEvidence &f : o.faces)
+            faces.push_back({{"face", f.face},
+                             {"pixels", f.pixels},
+                             {"nearest", num(f.nearest)},
+                             {"pixel", {f.x, f.y}},
+                             {"leafs", leafs(f.leafs)},
+                             {"leafs_omitted", f.leafsOmitted}});
+        Json oj = {{"object", o.object},
+                   {"name", o.name},
+                   {"model", o.model},
+                   {"entity", o.entity},
+                   {"classname", o.classname},
+                   {"triangles", o.triangles},
+                   {"pixels", o.pixels},
+                   {"nearest", num(o.nearest)},
+                   {"clusters", clusters},
+                   {"clusters_omitted", o.clustersOmitted}};
+        if (o.model > 0) {
+            oj["box_leafs"] = leafs(o.boxLeafs);
+            oj["box_leafs_omitted"] = o.boxLeafsOmitted;
+        }
+        oj["faces"] = faces;
+        oj["faces_omitted"] = o.facesOmitted;
+        objects.push_back(oj);
+    }
+    return {{"camera_leaf", e.cameraLeaf},
+            {"camera_cluster", e.cameraCluster},
+            {"design_far_plane", e.designFarPlane > 0 ? num(e.designFarPlane) : Json(nullptr)},
+            {"false_cull_objects", e.falseCullObjects},
+            {"false_cull_pixels", e.falseCullPixels},
+            {"objects", objects},
+            {"objects_omitted", e.objectsOmitted}};
+}
+
 // The audit against the reference visibility (analysis/audit.h; docs/audits.md).
 Json auditJson(const ViewResult &v) {
     const ReferenceVisibility &ref = v.reference;
@@ -435,15 +488,24 @@ Json auditJson(const ViewResult &v) {
                             {"false_cull_triangles", s.falseCullTriangles},
                             {"false_cull_objects", s.falseCullObjects},
                             {"false_cull_pixels", s.falseCullPixels},
+                            {"false_cull_nearest", s.falseCullPixels ? num(s.falseCullNearest) : Json(nullptr)},
                             {"snapped_triangles", s.snappedTriangles},
                             {"snapped_pixels", s.snappedPixels},
+                            {"design_far_plane", s.designFarPlane > 0 ? num(s.designFarPlane) : Json(nullptr)},
+                            {"beyond_far_plane_triangles", s.beyondFarPlaneTriangles},
+                            {"beyond_far_plane_pixels", s.beyondFarPlanePixels},
+                            {"beyond_far_plane_nearest",
+                             s.beyondFarPlanePixels ? num(s.beyondFarPlaneNearest) : Json(nullptr)},
                             {"worst", worst}};
         falseObjects += s.falseCullObjects;
     }
     j["false_culls"] = {{"triangles", a.falseCullTriangles},
                         {"objects", falseObjects},
                         {"pixels", a.falseCullPixels},
+                        {"beyond_far_plane_triangles", a.beyondFarPlaneTriangles},
+                        {"beyond_far_plane_pixels", a.beyondFarPlanePixels},
                         {"by_stage", byStage}};
+    if (v.pvsEvidence.ran) j["pvs_evidence"] = pvsEvidenceJson(v.pvsEvidence);
     j["wasted_draws"] = {{"drawn_triangles", a.drawnTriangles},
                          {"drawn_objects", a.drawnObjects},
                          {"triangles", a.wastedTriangles},
@@ -554,11 +616,31 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
                         {"non_solid_triangles", f.nonSolidTriangles},
                         {"unleafed_faces", f.unleafedFaces},
                         {"model_faces", f.modelFaces},
+                        {"brush_entities_drawn", r.bsp->drawnBrushEntities},
+                        {"brush_entities_not_drawn", r.bsp->notDrawnBrushEntities},
+                        {"not_drawn_entity_faces", f.notDrawnEntity},
+                        {"not_drawn_entity_triangles", f.notDrawnEntityTriangles},
                         {"leafs", r.bsp->leafs},
                         {"clusters", r.bsp->clusters},
                         {"patch_level", r.bsp->patchLevel},
                         {"has_pvs", r.bsp->hasPvs},
                         {"spawn_points", r.bsp->spawnPoints}};
+        Json notDrawn = Json::array();
+        for (const auto &e : r.bsp->notDrawn)
+            notDrawn.push_back({{"model", e.model},
+                                {"entity", e.entity},
+                                {"classname", e.classname},
+                                {"reason", e.reason},
+                                {"faces", e.faces},
+                                {"triangles", e.triangles}});
+        scene["bsp"]["not_drawn_entities"] = notDrawn;
+        const BspFarPlane &fp = r.bsp->farPlane;
+        scene["bsp"]["far_plane"] = fp.distance > 0 ? Json{{"distance", fp.distance},
+                                                           {"mode", fp.mode ? std::string(1, fp.mode) : std::string()},
+                                                           {"key", fp.key},
+                                                           {"value", fp.value}}
+                                                     : Json(nullptr);
+        scene["bsp"]["fog_shader"] = r.bsp->fogShader.empty() ? Json(nullptr) : Json(r.bsp->fogShader);
     }
     j["scene"] = scene;
     j["load_ms"] = num(r.loadMs);
@@ -676,7 +758,8 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     std::vector<std::string> stageOrder;
     std::map<std::string, uint64_t> culled;
     uint64_t covered = 0, fragments = 0, passes = 0;
-    uint64_t falseTris = 0, falsePixels = 0, wastedTris = 0, wastedFragments = 0, genuine = 0, hotspots = 0;
+    uint64_t falseTris = 0, falsePixels = 0, beyondPixels = 0, wastedTris = 0, wastedFragments = 0, genuine = 0,
+             hotspots = 0;
     std::map<std::string, uint64_t> falseByStage;
     double totalMs = 0;
     // A count of a section that may be absent (a stage or audit that did not run) reads as 0.
@@ -691,6 +774,7 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     for (const Json &v : views) {
         falseTris += count(v, {"audit", "false_culls", "triangles"});
         falsePixels += count(v, {"audit", "false_culls", "pixels"});
+        beyondPixels += count(v, {"audit", "false_culls", "beyond_far_plane_pixels"});
         if (v.contains("audit") && v["audit"].contains("false_culls"))
             for (const auto &[stage, st] : v["audit"]["false_culls"]["by_stage"].items())
                 falseByStage[stage] += count(st, {"false_cull_triangles"});
@@ -722,6 +806,7 @@ nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     totals["false_cull_triangles"] = falseTris;
     totals["false_cull_pixels"] = falsePixels;
     totals["false_cull_triangles_by_stage"] = falseStages;
+    totals["beyond_far_plane_pixels"] = beyondPixels;
     totals["wasted_triangles"] = wastedTris;
     totals["wasted_fragments"] = wastedFragments;
     totals["genuine_disagreements"] = genuine;

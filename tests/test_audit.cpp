@@ -322,6 +322,29 @@ TEST(AuditBroken, FrustumPushedInwardsIsCaughtExactly) {
         }
     EXPECT_GT(cb.genuine, a.stages[0].falseCullPixels * 9 / 10);
     EXPECT_LE(cb.genuine, a.stages[0].falseCullPixels);
+    // Like with like, as the pipeline compares (issue 15): the ray caster over the broken pipeline's
+    // own triangles agrees with its z-buffer (no genuine disagreement); the culled boxes are the
+    // audit's false culls, and the pixels where the whole-scene rays hit them are the "culled" count.
+    {
+        std::vector<uint32_t> all(scene.objects.size());
+        for (uint32_t o = 0; o < all.size(); ++o) all[o] = o;
+        RayScene rs;
+        std::string err;
+        ASSERT_TRUE(rs.build({scene.positions.data(), scene.indices.data()}, scene.positions.size(),
+                             cullBackfaces(scene, all, cam).kept.triangles, origin, &err))
+            << err;
+        std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
+        for (uint32_t t : broken.kept.triangles) outOfSet[t] = 0;
+        PrimaryOptions opt;
+        opt.rejectSource = outOfSet.data();
+        const RaycastImage same = rs.castPrimary(cam, opt, nullptr);
+        const CrossCheck cs = crossCheck(broken.z.buffer.id, broken.z.buffer.depth, same.id, same.depth, scene, cam, enc, origin);
+        EXPECT_EQ(cs.genuine, 0u);
+        uint64_t culled = 0;
+        for (uint32_t id : img.id) culled += id && outOfSet[id - 1];
+        EXPECT_GE(culled, cb.genuine);
+        EXPECT_LE(culled, a.stages[0].falseCullPixels + 2 * 17 * 4);  // + the boxes' edge pixels
+    }
 
     // The images, read back: the culling image shows exactly the false-cull pixels in stage 0's
     // color above its legend; the diff image the genuine pixels in red; the ids round-trip.

@@ -143,6 +143,40 @@ TEST(Raycast, BackFaceRejection) {
     }
 }
 
+// A cast over a subset of the triangles (PrimaryOptions::rejectSource, the cross-check's "like with
+// like"): a near quad facing the camera in front of a far quad. Rejecting the near quad's triangles
+// sees the far quad exactly where the plain cast saw the near one, at the far quad's depth; the
+// rest of the image is unchanged; with back-face rejection too, both rules apply.
+TEST(Raycast, RejectSourceCastsASubset) {
+    const Scene s = sceneOf({quadZ(0, 1, true), quadZ(-2, 10, true)});  // triangles 0,1: near; 2,3: far
+    auto rs = rayScene(s);
+    for (bool ortho : {false, true}) {
+        const Camera cam = cameraOf({0, 0, 5}, {0, 0, 0}, 32, 32, ortho, 3, 30);
+        const RaycastImage plain = rs->castPrimary(cam, nullptr);
+        const std::vector<uint8_t> outOfSet = {1, 1, 0, 0};
+        PrimaryOptions opt;
+        opt.rejectSource = outOfSet.data();
+        const RaycastImage sub = rs->castPrimary(cam, opt, nullptr);
+        opt.rejectBackFaces = true;
+        opt.planes = s.planes.data();
+        const RaycastImage both = rs->castPrimary(cam, opt, nullptr);
+        uint64_t nearPixels = 0;
+        for (size_t p = 0; p < plain.id.size(); ++p) {
+            ASSERT_NE(plain.id[p], 0u);
+            if (plain.id[p] <= 2) {
+                ++nearPixels;
+                EXPECT_GE(sub.id[p], 3u) << p;
+                EXPECT_FLOAT_EQ(sub.depth[p], 7.0f) << p;
+            } else {
+                EXPECT_EQ(sub.id[p], plain.id[p]) << p;
+                EXPECT_EQ(sub.depth[p], plain.depth[p]) << p;
+            }
+            EXPECT_EQ(both.id[p], sub.id[p]) << p;
+        }
+        EXPECT_GT(nearPixels, 200u);
+    }
+}
+
 // A camera inside a closed box: every primary ray hits (the inside is the boxes' back faces);
 // with back-face rejection none does.
 TEST(Raycast, CameraInsideClosedBox) {

@@ -16,6 +16,7 @@
 
 #include "reports/console.h"
 #include "reports/font.h"
+#include "reports/html.h"
 #include "reports/report.h"
 
 namespace va {
@@ -26,7 +27,7 @@ namespace fs = std::filesystem;
 
 // ---- A small JSON Schema validator (the subset docs/report-schema.json uses) ------------------
 // Keywords: $ref (local "#/$defs/NAME"), type (string or array), const, enum, minimum, required,
-// properties, additionalProperties (false or a schema), items, minItems, maxItems.
+// properties, additionalProperties (false or a schema), items, minItems, maxItems, maximum.
 
 bool typeMatches(const std::string &t, const Json &v) {
     if (t == "object") return v.is_object();
@@ -43,7 +44,7 @@ bool typeMatches(const std::string &t, const Json &v) {
 void validate(const Json &root, const Json &schema, const Json &v, const std::string &where,
               std::vector<std::string> *errors) {
     static const std::vector<std::string> kKnown = {
-        "$schema", "$id", "title", "description", "$ref", "type", "const", "enum", "minimum", "required",
+        "$schema", "$id", "title", "description", "$ref", "type", "const", "enum", "minimum", "maximum", "required",
         "properties", "additionalProperties", "items", "minItems", "maxItems", "$defs"};
     for (auto it = schema.begin(); it != schema.end(); ++it)
         if (std::find(kKnown.begin(), kKnown.end(), it.key()) == kKnown.end())
@@ -73,6 +74,8 @@ void validate(const Json &root, const Json &schema, const Json &v, const std::st
         errors->push_back(where + ": " + v.dump() + " not in enum");
     if (schema.contains("minimum") && v.is_number() && v.get<double>() < schema["minimum"].get<double>())
         errors->push_back(where + ": " + v.dump() + " below minimum");
+    if (schema.contains("maximum") && v.is_number() && v.get<double>() > schema["maximum"].get<double>())
+        errors->push_back(where + ": " + v.dump() + " above maximum");
     if (v.is_object()) {
         if (schema.contains("required"))
             for (const auto &r : schema["required"])
@@ -268,6 +271,69 @@ TEST(ReportJson, EverySchemaFieldHasADescription) {
     EXPECT_TRUE(missing.empty());
 }
 
+// A Quake 3 map's sections (issue 15): the brush entities never drawn, the far plane, the culling
+// audit's hidden-by-design counts and the PVS evidence, valid against the schema and as written.
+TEST(ReportJson, QuakeMapSectionsValidate) {
+    AnalysisResult r = syntheticResult();
+    AnalysisResult::BspSummary b;
+    b.leafs = 8, b.clusters = 2, b.hasPvs = true, b.drawnBrushEntities = 2, b.notDrawnBrushEntities = 2;
+    b.faces.notDrawnEntity = 2, b.faces.notDrawnEntityTriangles = 4;
+    b.notDrawn = {{2, 6, "trigger_teleport", "trigger", 1, 2}, {4, -1, "", "no entity", 1, 2}};
+    b.farPlane = {2048, 'o', "_farplanedist", "2048o"};
+    r.bsp = b;
+    ViewResult &v = r.views[0];
+    v.auditRan = true;
+    StageCullAudit cells;
+    cells.stage = "cells";
+    cells.falseCullTriangles = 1, cells.falseCullObjects = 1, cells.falseCullPixels = 3, cells.falseCullNearest = 100.5;
+    cells.designFarPlane = 2048, cells.beyondFarPlaneTriangles = 2, cells.beyondFarPlanePixels = 7;
+    cells.beyondFarPlaneNearest = 2050.25;
+    cells.worst = {{5, "model5", 1, 3}};
+    v.cullAudit.stages = {cells};
+    v.cullAudit.falseCullTriangles = 1, v.cullAudit.falseCullPixels = 3;
+    v.cullAudit.beyondFarPlaneTriangles = 2, v.cullAudit.beyondFarPlanePixels = 7;
+    PvsEvidence &e = v.pvsEvidence;
+    e.ran = true, e.cameraLeaf = 0, e.cameraCluster = 0, e.designFarPlane = 2048;
+    e.falseCullObjects = 1, e.falseCullPixels = 3;
+    PvsObjectEvidence o;
+    o.object = 5, o.name = "model5", o.model = 5, o.entity = 8, o.classname = "func_door";
+    o.triangles = 1, o.pixels = 3, o.nearest = 100.5;
+    o.clusters = {{1, 0}};
+    o.boxLeafs = {{1, 1, true, 0}};
+    PvsFaceEvidence f;
+    f.face = 12, f.pixels = 3, f.nearest = 100.5, f.x = 2, f.y = 1;
+    f.leafs = {{7, 0, false, 1}, {9, -1, true, -1}};
+    o.faces = {f};
+    e.objects = {o};
+    const Json j = reportJson(r);
+    const auto errors = validateReport(loadSchema(), j);
+    for (const auto &err : errors) ADD_FAILURE() << err;
+    EXPECT_TRUE(errors.empty());
+    const Json &bsp = j["scene"]["bsp"];
+    EXPECT_EQ(bsp["not_drawn_entities"].dump(),
+              R"([{"model":2,"entity":6,"classname":"trigger_teleport","reason":"trigger","faces":1,"triangles":2},)"
+              R"({"model":4,"entity":-1,"classname":"","reason":"no entity","faces":1,"triangles":2}])");
+    EXPECT_EQ(bsp["far_plane"].dump(), R"({"distance":2048.0,"mode":"o","key":"_farplanedist","value":"2048o"})");
+    EXPECT_TRUE(bsp["fog_shader"].is_null());
+    const Json &a = j["views"][0]["audit"];
+    EXPECT_EQ(a["false_culls"]["beyond_far_plane_pixels"], 7);
+    EXPECT_EQ(a["false_culls"]["by_stage"]["cells"]["design_far_plane"], 2048.0);
+    EXPECT_EQ(a["false_culls"]["by_stage"]["cells"]["beyond_far_plane_nearest"], 2050.25);
+    EXPECT_EQ(a["pvs_evidence"]["objects"][0]["box_leafs"].dump(),
+              R"([{"leaf":1,"cluster":1,"in_tree":true,"pvs_bit":0}])");
+    EXPECT_EQ(a["pvs_evidence"]["objects"][0]["faces"][0]["leafs"].dump(),
+              R"([{"leaf":7,"cluster":0,"in_tree":false,"pvs_bit":1},{"leaf":9,"cluster":-1,"in_tree":true,"pvs_bit":null}])");
+    EXPECT_EQ(j["totals"]["beyond_far_plane_pixels"], 7);
+    // The page shows the evidence and the entities the engine never draws.
+    const std::string html = reportHtml(j, "");
+    EXPECT_NE(html.find("Evidence of the PVS's false culls"), std::string::npos);
+    EXPECT_NE(html.find("leaf 7: cluster 0, bit 1 (not in the tree)"), std::string::npos);
+    EXPECT_NE(html.find("id=\"not-drawn-table\""), std::string::npos);
+    EXPECT_NE(html.find("trigger_teleport"), std::string::npos);
+    EXPECT_NE(html.find("<code>_farplanedist 2048o</code>"), std::string::npos);
+    EXPECT_NE(html.find("hidden by design"), std::string::npos);
+}
+
 // The validator must be able to fail, or the test above proves nothing.
 TEST(ReportJson, ValidatorRejectsBrokenReports) {
     const Json schema = loadSchema();
@@ -454,6 +520,7 @@ TEST(ReportJson, EmptyResult) {
     EXPECT_EQ(j["totals"].dump(),
               R"({"views":0,"triangles_culled":{},"covered_pixels":0,"fragments":0,"depth_passes":0,)"
               R"("false_cull_triangles":0,"false_cull_pixels":0,"false_cull_triangles_by_stage":{},)"
+              R"("beyond_far_plane_pixels":0,)"
               R"("wasted_triangles":0,"wasted_fragments":0,"genuine_disagreements":0,"zfight_hotspots":0,"total_ms":0.0})");
     EXPECT_TRUE(validateReport(loadSchema(), j).empty());
 }
