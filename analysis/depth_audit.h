@@ -120,9 +120,11 @@ struct DepthResolutionSample {
     // The resolution reported: stepToNext, or stepToPrev where there is no next value. Best: small.
     std::optional<double> resolution;
     // True when the neighbor behind `resolution` is more than one key away: the format holds values
-    // in between that no double depth produces (f32 just above z = 0 at near, f32_reversed just
-    // above 0 at far: floats there are denser than the doubles d), so the step is the input's
-    // double spacing, not the format's. closedForm (the format's own spacing) is then far smaller.
+    // in between that are never produced (f32 just above z = 0 at near, f32_reversed just above 0
+    // at far: floats there are denser than the doubles d; f32_gl and f32_gl_reversed where the
+    // window depth's floats are denser than the float z_ndc before it), so the step is that
+    // input's spacing, not the stored float's. closedForm is then smaller (except for the OpenGL
+    // formats, whose closed form takes z_ndc's spacing).
     bool skipsValues = false;
     // Width of the interval of double depths that store exactly d's value, measured by bisecting
     // the encoder for both ends (the clamped first/last buckets are cut at near/far, so at near and

@@ -761,7 +761,7 @@ const Command kCommands[] = {
     {"grade", "Score a student's per-stage counts against a reference report (exit 1 on any failure)",
      addGradeOptions, cmdGrade},
     {"merge", "Join the reports of analyze --shard K/N runs into one report", addMergeOptions, cmdMerge},
-    {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
+    {"depth-audit", "Per depth format: resolution against distance, distinct values, from where 1 cm / 1 mm can fight",
      addDepthAuditOptions, cmdDepthAudit},
 };
 

@@ -1,7 +1,7 @@
 #include "render/depth_format.h"
 
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 
 #include "render/depth_format_impl.h"
@@ -33,14 +33,12 @@ const DepthFormatInfo kInfo[kDepthFormatCount] = {
      "round((2^24-1) * f(d-n)/(d(f-n))) (WebGPU depth24plus as 24-bit depth)"},
 };
 
-// The shortest %.Ng rendering of x that reads back as x (1 to 17 significant digits).
+// The shortest decimal that reads back as x (std::to_chars: fixed or scientific, whichever is
+// shorter): 0.001, 100, 1e-05.
 std::string shortestDecimal(double x) {
-    char buf[40];
-    for (int digits = 1; digits <= 17; ++digits) {
-        std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-        if (std::strtod(buf, nullptr) == x) break;
-    }
-    return buf;
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, r.ptr);
 }
 
 std::string knownNames() {

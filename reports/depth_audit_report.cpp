@@ -85,7 +85,9 @@ std::string depthAuditTable(const DepthAuditResult &r) {
            "shares a value with probability >= 50%\n";
     out += "never: no bucket up to far is that wide\n";
     if (anyOut) out += "-: depth outside the format's range (range column); it clamps to the range's end\n";
-    if (anySkip) out += "*: step limited by the double-precision depth input, not by the format (floats there are denser)\n";
+    if (anySkip)
+        out += "*: the next value produced is more than one stored value away: the floats there are denser than what "
+               "feeds them (the double depth, or the OpenGL formats' float z_ndc), which sets the step\n";
     for (const DepthFormatAudit &a : r.formats)
         if (!a.rangeNote.empty()) out += a.name + ": " + a.rangeNote + "\n";
     return out;
