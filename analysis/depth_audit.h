@@ -6,8 +6,13 @@
 //     next to the closed form (derivative of the mapping times the stored value's spacing);
 //   - a dense resolution curve (for the log-log plot, reports/depth_plot.h);
 //   - the number of distinct stored values over [near, far];
-//   - the "fight distance": the smallest depth at which two surfaces a given gap apart (1 cm, 1 mm)
-//     collapse to the same stored value (or swap order);
+//   - per surface gap (1 cm, 1 mm) the fight *onset*: the smallest depth at which a stored value's
+//     bucket (the interval of depths that store it) is wider than the gap, so two surfaces the gap
+//     apart can share a stored value; and the *likely* distance, from where a bucket is at least
+//     twice the gap wide (a random pair the gap apart shares a value with probability >= 50%).
+//     Both exact: searched over the format's bucket structure (the exact inverse of its stored
+//     value), not sampled; docs/depth-formats.md says how for the formats whose buckets are not
+//     monotone in depth;
 //   - the part of [near, far] the format can represent at all.
 //
 // Usage (the `visaudit depth-audit` command):
@@ -21,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,9 +56,48 @@ double depthBetweenStored(const DepthEncoder &e, double a, double b);
 double storedFromKey(const DepthEncoder &e, uint32_t key);
 
 // True when surfaces at depths d and d + gap (gap > 0) are no longer ordered by the format: the
-// farther one's key is not larger (equal stored values, or swapped). This is the z-fighting
-// predicate the fight distance searches for.
+// farther one's key is not larger (equal stored values, or swapped). The z-fighting predicate.
 bool depthFormatFights(const DepthEncoder &e, double d, double gap);
+
+// ---- Buckets ----------------------------------------------------------------------------------
+// A stored value's *bucket* is the interval of view depths that store it. Its ends are the depths
+// at which the format's exact real-number mapping crosses a rounding threshold (half-way between
+// two stored values for rounding formats, an integer for truncating ones, the threshold of the
+// first float of the intermediate z_ndc for the OpenGL formats), mapped back through the exact
+// inverse; docs/depth-formats.md lists them. The encoder's double arithmetic moves an end by a few
+// ulps of the mapping (a relative 1e-9 of the bucket's width or less, tests/test_depth_audit.cpp).
+
+// The part of [near, far] the encoder represents: [lo, hi]; *note (may be null) says why a part is
+// not (empty when all of it is).
+void depthRepresentableRange(const DepthEncoder &e, double *lo, double *hi, std::string *note);
+
+struct DepthBucket {
+    uint32_t key = 0;      // ordering key of the stored value
+    double lo = 0, hi = 0; // the bucket's depths, cut to the representable range
+    double width = 0;      // hi - lo, computed without cancellation (inside the range)
+};
+// The bucket of depth d (the encoder's key of d); nullopt when d is outside the representable range.
+std::optional<DepthBucket> depthBucketAt(const DepthEncoder &e, double d);
+
+struct DepthBucketFound {
+    double depth = 0;      // where the bucket starts (cut to the search range's start)
+    uint32_t key = 0;      // its ordering key
+    double width = 0;      // its width, cut to the search range
+};
+// The first bucket in depth order over [lo, hi] (inside the representable range) whose width, cut
+// to [lo, hi], is > minWidth (orEqual: >= minWidth). nullopt when no bucket is. Exact: every
+// bucket is either proved narrower by a monotone bound (bisection over the keys of runs whose
+// widths are monotone) or measured; up to buckets whose width equals minWidth to about 15
+// significant digits, which the double arithmetic may count either way.
+std::optional<DepthBucketFound> firstBucketWiderThan(const DepthEncoder &e, double lo, double hi, double minWidth,
+                                                     bool orEqual = false);
+
+// The fight onset for surfaces `gap` apart over [lo, hi]: the first bucket wider than gap (two
+// surfaces at its start and gap behind share its stored value); the likely distance: the first
+// bucket at least 2 * gap wide (a pair gap apart at a random place in it shares the value with
+// probability (width - gap)/width >= 1/2). nullopt: none up to hi.
+std::optional<DepthBucketFound> fightOnset(const DepthEncoder &e, double lo, double hi, double gap);
+std::optional<DepthBucketFound> fightLikely(const DepthEncoder &e, double lo, double hi, double gap);
 
 // ---- Result ------------------------------------------------------------------------------------
 
@@ -75,9 +120,11 @@ struct DepthResolutionSample {
     // The resolution reported: stepToNext, or stepToPrev where there is no next value. Best: small.
     std::optional<double> resolution;
     // True when the neighbor behind `resolution` is more than one key away: the format holds values
-    // in between that no double depth produces (f32 just above z = 0 at near, f32_reversed just
-    // above 0 at far: floats there are denser than the doubles d), so the step is the input's
-    // double spacing, not the format's. closedForm (the format's own spacing) is then far smaller.
+    // in between that are never produced (f32 just above z = 0 at near, f32_reversed just above 0
+    // at far: floats there are denser than the doubles d; f32_gl and f32_gl_reversed where the
+    // window depth's floats are denser than the float z_ndc before it), so the step is that
+    // input's spacing, not the stored float's. closedForm is then smaller (except for the OpenGL
+    // formats, whose closed form takes z_ndc's spacing).
     bool skipsValues = false;
     // Width of the interval of double depths that store exactly d's value, measured by bisecting
     // the encoder for both ends (the clamped first/last buckets are cut at near/far, so at near and
@@ -92,18 +139,23 @@ struct DepthResolutionSample {
     std::optional<double> relativeDifference;
 };
 
-// The fight distance for one gap.
+// The fight distances for one gap (m). Best: absent, or large.
 struct DepthFightDistance {
     double gap = 0;                  // distance between the two surfaces (m), e.g. 0.01 or 0.001
-    // The smallest depth d found at which surfaces at d and d + gap fight (depthFormatFights);
-    // absent ("never") when they do not fight anywhere in the representable part of
-    // [near, far - gap]. Best: absent, or large.
-    std::optional<double> distance;
+    // The onset: the smallest depth at which a stored value's bucket is wider than the gap, so two
+    // surfaces the gap apart can share a stored value (fightOnset). Absent ("never") when no bucket
+    // of the representable part of [near, far] is.
+    std::optional<double> onset;
+    std::optional<double> onsetBucket;  // that bucket's width (m, > gap)
+    // The likely distance: the smallest depth at which a bucket is at least 2 x gap wide; a random
+    // pair of surfaces the gap apart there shares a stored value with probability >= 50%
+    // (fightLikely). Absent: never.
+    std::optional<double> likely;
 };
 
 struct DepthFormatAudit {
-    DepthFormat format = DepthFormat::f32;
-    std::string name;                // format name as DESIGN.md and --formats spell it
+    DepthFormatSpec format;          // the format (log24's C included)
+    std::string name;                // format name as DESIGN.md and --formats spell it (log24:C=X)
     int bits = 0;                    // bits of the stored value
     bool nearerIsLarger = false;     // comparison direction of the stored value
     // Distinct stored values over [near, far] (exact, from the ordering keys: key(far) - key(near)
@@ -124,7 +176,6 @@ struct DepthFormatAudit {
 struct DepthAuditSettings {
     std::vector<double> fightGaps = {0.01, 0.001};  // surface gaps (m) for fight distances
     int curveSamples = 200;                         // dense-curve samples between near and far
-    int fightScanSamples = 2000;                    // coarse log-spaced scan before bisection
 };
 
 struct DepthAuditResult {
@@ -142,9 +193,24 @@ struct DepthAuditResult {
 // On failure returns false and *err names the value and the fix.
 bool validateDepthAuditRange(double nearZ, double farZ, std::string *err);
 
-// The audit. Invalid input (see validateDepthAuditRange; also an empty or repeated format list,
-// a gap that is not finite and > 0) returns a result with `error` set and no formats.
+// The audit. Invalid input (see validateDepthAuditRange and validateDepthFormatRange; also an
+// empty or repeated format list, a gap that is not finite and > 0) returns a result with `error`
+// set and no formats.
+DepthAuditResult auditDepthFormats(double nearZ, double farZ, const std::vector<DepthFormatSpec> &formats,
+                                   const DepthAuditSettings &settings = {});
+// The same over plain formats (log24 with C = 1).
 DepthAuditResult auditDepthFormats(double nearZ, double farZ, const std::vector<DepthFormat> &formats,
                                    const DepthAuditSettings &settings = {});
+DepthAuditResult auditDepthFormats(double nearZ, double farZ, std::initializer_list<DepthFormat> formats,
+                                   const DepthAuditSettings &settings = {});
+
+// ---- Cheapest format ----------------------------------------------------------------------------
+// Every format in the order "cheapest first": fewer bits of stored value first; among equal bits,
+// by how much a renderer must change to use it: (1) a depth buffer with the standard projection,
+// (2) the same buffer with reversed-Z (projection and depth test change), (3) API-specific
+// variants of these (OpenGL's [-1, 1] window transform, WebGPU's names), (4) a shader-written
+// logarithmic depth (costs early-Z), (5) formats no GPU depth buffer has (software z-buffers:
+// linear_f32, inv_f32 and the integer 1/d formats). docs/depth-formats.md has the list.
+const std::vector<DepthFormat> &depthFormatsCheapestFirst();
 
 }  // namespace va

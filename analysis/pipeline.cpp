@@ -84,6 +84,10 @@ bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, C
         *err = "view '" + v.name + "': " + m;
         return false;
     }
+    if (!validateDepthFormatRange(v.depthFormat, cam->nearZ, cam->farZ, &m)) {
+        *err = "view '" + v.name + "': " + m;
+        return false;
+    }
     *out = v;
     return true;
 }
@@ -384,7 +388,13 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     if (stopped()) return r;
     if (s.zfight) {
         const Stopwatch t0;
-        r.zfight = analyzeZFighting(scene, cam, clip.out, s.zfightSettings);
+        // The view's own format is always evaluated (budgets read its row) and explains hotspots.
+        ZFightSettings zs = s.zfightSettings;
+        zs.viewFormat = view.depthFormat;
+        if (std::find(zs.formats.begin(), zs.formats.end(), view.depthFormat) == zs.formats.end() &&
+            zs.formats.size() < 32)
+            zs.formats.push_back(view.depthFormat);
+        r.zfight = analyzeZFighting(scene, cam, clip.out, zs);
         r.zfightMs = t0.ms();
         r.zfightRan = true;
     } else {

@@ -42,13 +42,13 @@ struct PipelineSettings {
     DetailSettings detailSettings;      // --detail-min-pixels, --detail-triangles-per-pixel
     bool backface = true;  // --no-backface turns the stage off
     int width = 0, height = 0;                 // > 0: override every view's resolution
-    std::optional<DepthFormat> depthFormat;    // override every view's depth format
+    std::optional<DepthFormatSpec> depthFormat;  // override every view's depth format
     ClipSettings clip;
     bool zfight = true;    // --no-zfight turns the z-fighting analysis off
     bool audit = true;     // --no-audit turns the reference-visibility audit off
     bool raycast = true;   // --no-raycast turns the raycast stage (and the effects) off
     EffectFlags effects;   // --shadows/--no-shadows, ..., --max-depth
-    ZFightSettings zfightSettings;
+    ZFightSettings zfightSettings;  // its formats: --zfight-formats (each view's own is added)
     Limits limits;                             // refused before allocating (docs/limits.md)
     int threads = 0;                           // 0: all cores
     // Not null: analyzeScene stops between views and stages once it holds a nonzero value (the CLI's

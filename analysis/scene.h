@@ -33,7 +33,7 @@ struct Light {
 struct ViewSpec {
     std::string name;
     CameraSpec camera;
-    DepthFormat depthFormat = DepthFormat::f32;
+    DepthFormatSpec depthFormat = DepthFormat::f32;
     std::string origin;  // where it came from: "scene", a views file, "orbit:N", "gltf camera"
 };
 

@@ -10,7 +10,8 @@
 //      the pixel's corners;
 //   4. 8-connected components of the hotspot pixels (separated or coplanar) with their statistics,
 //      sorted into hotspot ids;
-//   5. per-format counts and the recommendation.
+//   5. per-format counts and the recommendation;
+//   6. per listed hotspot, why it fights (explainHotspot).
 #include "analysis/zfight.h"
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "analysis/depth_audit.h"
 #include "render/depth_format_impl.h"
 #include "render/raster_core.h"
 
@@ -35,7 +37,7 @@ const char *zPixelClassName(ZPixelClass c) {
     return "none";
 }
 
-const ZFightFormatStats *zfightStatsOf(const ZFightResult &r, DepthFormat format) {
+const ZFightFormatStats *zfightStatsOf(const ZFightResult &r, const DepthFormatSpec &format) {
     for (const ZFightFormatStats &s : r.perFormat)
         if (s.format == format) return &s;
     return nullptr;
@@ -270,7 +272,7 @@ Vec3 worldPointAt(const Camera &cam, double px, double py, double d) {
     return cam.eye + cam.right * v.x + cam.up * v.y - cam.forward * v.z;
 }
 
-bool validate(const ZFightSettings &s, std::string *err) {
+bool validate(const ZFightSettings &s, const Camera &cam, std::string *err) {
     if (s.formats.empty()) {
         *err = "no depth formats to evaluate; pass at least one (e.g. all of allDepthFormats())";
         return false;
@@ -282,10 +284,11 @@ bool validate(const ZFightSettings &s, std::string *err) {
     for (size_t i = 0; i < s.formats.size(); ++i)
         for (size_t j = 0; j < i; ++j)
             if (s.formats[i] == s.formats[j]) {
-                *err = std::string("depth format '") + depthFormatInfo(s.formats[i]).name +
-                       "' is listed twice; list each format once";
+                *err = "depth format '" + depthFormatName(s.formats[i]) + "' is listed twice; list each format once";
                 return false;
             }
+    for (const DepthFormatSpec &f : s.formats)
+        if (!validateDepthFormatRange(f, cam.nearZ, cam.farZ, err)) return false;
     if (!(std::isfinite(s.sharedEdgePixels) && s.sharedEdgePixels >= 0)) {
         *err = "sharedEdgePixels must be a finite distance >= 0 (pixels); the default is 1";
         return false;
@@ -295,12 +298,59 @@ bool validate(const ZFightSettings &s, std::string *err) {
 
 }  // namespace
 
+// ---- Why a hotspot fights ------------------------------------------------------------------------
+
+void explainHotspot(double nearZ, double farZ, const std::optional<DepthFormatSpec> &viewFormat, bool coplanar,
+                    ZFightHotspot *h) {
+    auto m = [](double v) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.3g m", v);
+        return std::string(b);
+    };
+    h->coplanar = coplanar;
+    h->viewBucketWidth.reset();
+    h->cheapestFormat.reset();
+    h->cheapestBucketWidth.reset();
+    std::string view;
+    if (viewFormat)
+        if (const auto b = depthBucketAt(makeDepthEncoder(*viewFormat, nearZ, farZ), h->depth)) {
+            h->viewBucketWidth = b->width;
+            view = depthFormatName(*viewFormat) + "'s stored-value bucket there is " + m(b->width) + " wide, " +
+                   (b->width > h->depthGap ? "wider than the gap"
+                                            : "no wider than the gap (its fighting pixels lie at other depths or gaps "
+                                              "than these medians)");
+        }
+    if (coplanar) {
+        h->why = "coplanar surfaces: no depth format can order them; offset one surface or use a depth bias";
+        return;
+    }
+    // The cheapest format whose bucket at the hotspot's depth is no wider than the gap: then the
+    // surface the gap behind lies in a later bucket, whatever the position inside this one.
+    for (DepthFormat f : depthFormatsCheapestFirst()) {
+        const auto b = depthBucketAt(makeDepthEncoder(f, nearZ, farZ), h->depth);
+        if (b && b->width <= h->depthGap) {
+            h->cheapestFormat = f;
+            h->cheapestBucketWidth = b->width;
+            break;
+        }
+    }
+    h->why = "surfaces " + m(h->depthGap) + " apart at " + m(h->depth) + (view.empty() ? "" : "; " + view) + "; ";
+    if (h->cheapestFormat)
+        h->why += "the cheapest format that orders them there: " +
+                  std::string(depthFormatInfo(*h->cheapestFormat).name) + " (" +
+                  std::to_string(depthFormatInfo(*h->cheapestFormat).bits) + " bits, bucket " +
+                  m(*h->cheapestBucketWidth) + ")";
+    else
+        h->why += "every format's bucket there is wider than the gap: move the surfaces apart or pull the near "
+                  "plane out";
+}
+
 // ---- The analysis -----------------------------------------------------------------------------
 
 ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const ScreenTriangles &tris,
                               const ZFightSettings &settings) {
     ZFightResult r;
-    if (!validate(settings, &r.error)) return r;
+    if (!validate(settings, cam, &r.error)) return r;
     const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
     const size_t N = size_t(W) * size_t(H);
     const size_t F = settings.formats.size();
@@ -314,9 +364,9 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     r.hotspotOf.assign(N, 0);
     r.perFormat.resize(F);
     for (size_t i = 0; i < F; ++i) {
-        const DepthFormatInfo &info = depthFormatInfo(settings.formats[i]);
-        r.perFormat[i].format = info.format;
-        r.perFormat[i].name = info.name;
+        const DepthFormatInfo &info = depthFormatInfo(settings.formats[i].format);
+        r.perFormat[i].format = settings.formats[i];
+        r.perFormat[i].name = depthFormatName(settings.formats[i]);
         r.perFormat[i].bits = info.bits;
     }
 
@@ -497,6 +547,8 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
         h.objectB = sourceObjectName(scene, h.triangleB);
         for (size_t i = 0; i < F; ++i)
             if (cp.formatPixels[i]) h.formats.push_back({settings.formats[i], cp.formatPixels[i]});
+        // 6. Why it fights, at its median depth and gap.
+        explainHotspot(cam.nearZ, cam.farZ, settings.viewFormat, h.coplanarPixels == h.area, &h);
         r.hotspots.push_back(std::move(h));
     }
     for (size_t p = 0; p < N; ++p)

@@ -12,7 +12,9 @@
 //   4. hotspots: 8-connected components of the pixels that fight in at least one format and are
 //      coplanar or separated (shared-edge and intersection pixels are no hotspots);
 //   5. per format counts and the recommended format: the fewest bits that fights nowhere in this
-//      view apart from coplanar surfaces (no format can order those).
+//      view apart from coplanar surfaces (no format can order those);
+//   6. per listed hotspot, why it fights: its depth gap, the view format's stored-value bucket width
+//      at its depth, and the cheapest format whose bucket there is no wider than the gap.
 //
 // Usage (one call per view, after the clip stage):
 //     ZFightResult z = analyzeZFighting(scene, cam, clip.out, ZFightSettings{});
@@ -69,7 +71,12 @@ const char *zPixelClassName(ZPixelClass c);
 // ---- Settings and result ----------------------------------------------------------------------
 
 struct ZFightSettings {
-    std::vector<DepthFormat> formats = allDepthFormats();  // evaluated formats, in tie-break order
+    // Evaluated formats, in tie-break order: by default DESIGN.md's classic twelve
+    // (defaultZFightFormats); the others (and log24:C=X) are opt-in.
+    std::vector<DepthFormatSpec> formats{defaultZFightFormats().begin(), defaultZFightFormats().end()};
+    // The view's own format (the pipeline sets it): each hotspot gives its bucket width. Unset: the
+    // hotspots leave that out.
+    std::optional<DepthFormatSpec> viewFormat;
     uint64_t minHotspotArea = 1;    // components with fewer pixels are not hotspots (their pixels
                                     // still count as fighting pixels)
     size_t maxHotspotsListed = 50;  // hotspots kept with details (largest first); all are counted
@@ -80,8 +87,8 @@ struct ZFightSettings {
 };
 
 struct ZFightFormatStats {
-    DepthFormat format = DepthFormat::f32;
-    std::string name;
+    DepthFormatSpec format;
+    std::string name;         // depthFormatName(format)
     int bits = 0;
     // Pixels whose two surfaces fight in this format and are hotspot material (separated or
     // coplanar). Best 0.
@@ -96,7 +103,7 @@ struct ZFightFormatStats {
 };
 
 struct ZFightHotspotFormat {
-    DepthFormat format = DepthFormat::f32;
+    DepthFormatSpec format;
     uint64_t pixels = 0;  // hotspot pixels that fight in this format (> 0)
 };
 
@@ -116,13 +123,28 @@ struct ZFightHotspot {
     uint64_t pairPixels = 0;
     uint64_t pairs = 0;       // distinct triangle pairs in the hotspot
     std::vector<ZFightHotspotFormat> formats;  // formats fighting at its pixels, in settings order
+    // Why it fights, at `depth` with the gap `depthGap` (docs/zfighting.md, "Why a hotspot fights"):
+    //   viewBucketWidth: the width (m) of the view format's stored-value bucket at `depth` (the
+    //     interval of depths storing the same value, analysis/depth_audit.h); wider than the gap:
+    //     two surfaces the gap apart there can share a value. Absent without a view format or when
+    //     `depth` lies outside its range. Best: below depthGap.
+    //   cheapestFormat: the first format of depthFormatsCheapestFirst() (fewest bits, then the
+    //     least change to a renderer) whose bucket at `depth` is no wider than depthGap, so no two
+    //     surfaces depthGap apart at that depth share its value; cheapestBucketWidth is that width.
+    //     Absent when no format is: coplanar surfaces (gap 0: coplanar set), or a gap below every
+    //     format's bucket there.
+    std::optional<double> viewBucketWidth;
+    std::optional<DepthFormat> cheapestFormat;
+    std::optional<double> cheapestBucketWidth;
+    bool coplanar = false;    // coplanarPixels == area, or a median gap of 0: no format can help
+    std::string why;          // the above in one sentence
 };
 
 struct ZFightResult {
     std::string error;        // empty = ok; else what is wrong with the settings and the fix
     int width = 0, height = 0;
     double nearZ = 0, farZ = 0;
-    std::vector<DepthFormat> formats;       // as evaluated (settings order)
+    std::vector<DepthFormatSpec> formats;   // as evaluated (settings order)
     uint64_t coveredPixels = 0;             // pixels with at least one surface
     uint64_t twoSurfacePixels = 0;          // pixels with two surfaces (from distinct triangles)
     uint64_t fightingPixelsAnyFormat = 0;   // pixels fighting in at least one format (any class)
@@ -137,7 +159,7 @@ struct ZFightResult {
     // non-coplanar surfaces. recommendation says why, in one sentence, and names coplanar pixels
     // when there are any ("coplanar surfaces fight in every format: offset the decal or use a
     // depth bias").
-    std::optional<DepthFormat> recommended;
+    std::optional<DepthFormatSpec> recommended;
     std::string recommendation;
 
     // Per-pixel layers for the image (row-major, width x height).
@@ -148,12 +170,19 @@ struct ZFightResult {
 
 // The analysis. `tris` are the triangles the z-buffer draws for this view (clip stage output);
 // their `source` indices are scene triangle ids (names and vertex positions come from `scene`).
-// Invalid settings (no formats, a repeated format, more than 32 formats, sharedEdgePixels not
-// finite or < 0) return a result with `error` set.
+// Invalid settings (no formats, a repeated format, more than 32 formats, a format that cannot
+// encode the camera's range (validateDepthFormatRange), sharedEdgePixels not finite or < 0) return
+// a result with `error` set.
 ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const ScreenTriangles &tris,
                               const ZFightSettings &settings = {});
 
 // The per-format stats of `format` in r, or nullptr when it was not evaluated.
-const ZFightFormatStats *zfightStatsOf(const ZFightResult &r, DepthFormat format);
+const ZFightFormatStats *zfightStatsOf(const ZFightResult &r, const DepthFormatSpec &format);
+
+// Why surfaces `gap` apart at view depth `depth` fight (or not), for a view with near/far and its
+// format (optional): fills the hotspot's viewBucketWidth, cheapestFormat, cheapestBucketWidth and
+// why. `coplanar`: the surfaces lie in one plane (no format can order them).
+void explainHotspot(double nearZ, double farZ, const std::optional<DepthFormatSpec> &viewFormat, bool coplanar,
+                    ZFightHotspot *h);
 
 }  // namespace va

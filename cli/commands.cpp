@@ -68,6 +68,7 @@ struct Options {
     std::optional<bool> shadows, reflections, refractions, abuffer;
     int maxDepth = 4;
     uint64_t zfightMinArea = 1;
+    std::string zfightFormats;  // --zfight-formats: comma-separated or "all"; empty = the classic twelve
     bool quiet = false;
     bool json = false;  // --json: the summary on stdout
     // depth-audit
@@ -181,6 +182,33 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
     return true;
 }
 
+// "a,b,log24:C=0.01" or "all" into depth formats (in the order given); false + message on an
+// unknown or repeated name.
+bool parseDepthFormatList(const std::string &list, std::vector<DepthFormatSpec> *out, std::string *err) {
+    std::vector<DepthFormatSpec> formats;
+    if (list == "all") {
+        formats.assign(allDepthFormats().begin(), allDepthFormats().end());
+    } else {
+        std::stringstream ss(list);
+        std::string name;
+        while (std::getline(ss, name, ',')) {
+            DepthFormatSpec f;
+            if (!parseDepthFormat(name, &f, err)) return false;
+            if (std::find(formats.begin(), formats.end(), f) != formats.end()) {
+                *err = "depth format '" + depthFormatName(f) + "' is listed twice; list it once";
+                return false;
+            }
+            formats.push_back(f);
+        }
+    }
+    if (formats.empty()) {
+        *err = "no depth formats given; name at least one, e.g. f32,f32_reversed, or all";
+        return false;
+    }
+    *out = std::move(formats);
+    return true;
+}
+
 bool makeSettings(const Options &o, PipelineSettings *s) {
     s->frustum = !o.noFrustum;
     s->backface = !o.noBackface;
@@ -215,8 +243,15 @@ bool makeSettings(const Options &o, PipelineSettings *s) {
     s->limits.maxABufferList = o.maxABufferList;
     if (!memoryLimit(o, &s->limits.maxMemory)) return false;
     s->cancel = &gInterrupt;
+    if (!o.zfightFormats.empty()) {
+        std::string err;
+        if (!parseDepthFormatList(o.zfightFormats, &s->zfightSettings.formats, &err)) {
+            fail("--zfight-formats: " + err);
+            return false;
+        }
+    }
     if (!o.depthFormat.empty()) {
-        DepthFormat f;
+        DepthFormatSpec f;
         std::string err;
         if (!parseDepthFormat(o.depthFormat, &f, &err)) {
             fail("--depth-format: " + err);
@@ -255,18 +290,19 @@ int cmdInfo(const Options &o) {
     for (const ViewSpec &v : views)
         std::printf("  %-16s%dx%d %s eye [%g, %g, %g] %s\n", v.name.c_str(), v.camera.width, v.camera.height,
                     v.camera.orthographic ? "ortho" : "persp", v.camera.eye.x, v.camera.eye.y, v.camera.eye.z,
-                    depthFormatInfo(v.depthFormat).name);
+                    depthFormatName(v.depthFormat).c_str());
     return kExitOk;
 }
 
 // Runs `analyze` as the options say and writes the report folder. `beforeRun` (optional) sees the
-// views after loading and may refuse them (check validates its budget there, before any work);
-// `afterRun` (optional) gets the scene and the staging folder once the views are analysed, before
-// the report is written, and returns an exit code (check runs the PVS audit there); `report`
-// receives the report JSON. Returns an exit code.
+// views after loading and may refuse them (check validates its budget there, before any work) or
+// add to the settings (check: the depth formats its budget names); `afterRun` (optional) gets the
+// scene and the staging folder once the views are analysed, before the report is written, and
+// returns an exit code (check runs the PVS audit there); `report` receives the report JSON.
+// Returns an exit code.
 using AfterRun = std::function<int(const Scene &, const std::string &staging)>;
 int analyzeToReport(const Options &o,
-                    const std::function<bool(const std::vector<ViewSpec> &, std::string *)> &beforeRun,
+                    const std::function<bool(const std::vector<ViewSpec> &, PipelineSettings *, std::string *)> &beforeRun,
                     nlohmann::ordered_json *report, const AfterRun &afterRun = nullptr) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();  // progress lines (real time)
@@ -304,7 +340,7 @@ int analyzeToReport(const Options &o,
         bases.push_back(allBases[i]);
     }
     views = std::move(selected);
-    if (beforeRun && !beforeRun(views, &err)) {
+    if (beforeRun && !beforeRun(views, &settings, &err)) {
         fail(err);
         return kExitBadInput;
     }
@@ -589,10 +625,16 @@ int cmdCheck(const Options &o) {
         }
     }
     // The budget is validated against the views before anything is analysed.
-    auto validate = [&](const std::vector<ViewSpec> &views, std::string *e) {
+    auto validate = [&](const std::vector<ViewSpec> &views, PipelineSettings *s, std::string *e) {
         std::vector<std::string> names;
         for (const ViewSpec &v : views) names.push_back(v.name);
-        return loadBudget(o.budget, names, &budget, e);
+        if (!loadBudget(o.budget, names, &budget, e)) return false;
+        // The formats its min_depth_format limits name join the z-fighting analysis (opt-in ones too).
+        for (const DepthFormatSpec &f : budgetDepthFormats(budget))
+            if (std::find(s->zfightSettings.formats.begin(), s->zfightSettings.formats.end(), f) ==
+                s->zfightSettings.formats.end())
+                s->zfightSettings.formats.push_back(f);
+        return true;
     };
     // A budget naming pvs_* runs the PVS audit on the map too; its files go next to report.json.
     nlohmann::ordered_json pvsAudit;
@@ -725,7 +767,7 @@ void addMergeOptions(CLI::App *c, Options &o) {
 
 // depth-audit --scene: the per-view z-fighting analysis over a scene's views, with the formats'
 // verdicts and the recommendation per view (no images, no report folder).
-int depthAuditScene(const Options &o, const std::vector<DepthFormat> &formats) {
+int depthAuditScene(const Options &o, const std::vector<DepthFormatSpec> &formats) {
     Options lo = o;
     lo.scene = o.auditScene;
     installInterruptHandlers();
@@ -751,7 +793,7 @@ int depthAuditScene(const Options &o, const std::vector<DepthFormat> &formats) {
         const ZFightResult &z = v.zfight;
         std::printf("view '%s' %dx%d, near %g, far %g, its format %s: %llu hotspots\n", v.spec.name.c_str(),
                     v.camera.width, v.camera.height, v.camera.nearZ, v.camera.farZ,
-                    depthFormatInfo(v.spec.depthFormat).name, (unsigned long long)z.hotspotCount);
+                    depthFormatName(v.spec.depthFormat).c_str(), (unsigned long long)z.hotspotCount);
         for (const ZFightFormatStats &f : z.perFormat)
             std::printf("  %-18s %2d bits %10llu fighting [%llu]%s\n", f.name.c_str(), f.bits,
                         (unsigned long long)f.fightingPixels, (unsigned long long)f.coplanarPixels,
@@ -761,6 +803,7 @@ int depthAuditScene(const Options &o, const std::vector<DepthFormat> &formats) {
             std::printf("  hotspot %u: %llu px at world (%.3g, %.3g, %.3g), '%s' vs '%s', gap %.3g\n", h.id,
                         (unsigned long long)h.area, h.centroid.x, h.centroid.y, h.centroid.z, h.objectA.c_str(),
                         h.objectB.c_str(), h.depthGap);
+            std::printf("    why: %s\n", h.why.c_str());
         }
         std::printf("  %s\n", z.recommendation.c_str());
     }
@@ -778,20 +821,10 @@ int cmdDepthAudit(const Options &o) {
         fail(err);
         return kExitBadInput;
     }
-    std::vector<DepthFormat> formats;
-    if (o.formats.empty()) {
-        formats = allDepthFormats();
-    } else {
-        std::stringstream ss(o.formats);
-        std::string name;
-        while (std::getline(ss, name, ',')) {
-            DepthFormat f;
-            if (!parseDepthFormat(name, &f, &err)) {
-                fail("--formats: " + err);
-                return kExitBadInput;
-            }
-            formats.push_back(f);
-        }
+    std::vector<DepthFormatSpec> formats(allDepthFormats().begin(), allDepthFormats().end());
+    if (!o.formats.empty() && !parseDepthFormatList(o.formats, &formats, &err)) {
+        fail("--formats: " + err);
+        return kExitBadInput;
     }
     if (!range) return depthAuditScene(o, formats);
     const DepthAuditResult r = auditDepthFormats(o.nearZ, o.farZ, formats);
@@ -825,7 +858,8 @@ void addDepthAuditOptions(CLI::App *c, Options &o) {
     c->add_option("--scene", o.auditScene, "Also analyse this scene's views: per view, where each format z-fights "
                                            "and the recommended format");
     c->add_option("--views", o.views, "With --scene: a views file, orbit:N, spawns or walk:N");
-    c->add_option("--formats", o.formats, "Comma-separated depth formats (default: all)");
+    c->add_option("--formats", o.formats, "Comma-separated depth formats, log24:C=X for log24 with constant C, or "
+                                          "all (default: all)");
     c->add_option("--out", o.auditOut, "Folder for depth-audit.json and depth-audit.png");
 }
 
@@ -847,7 +881,8 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     c->add_option("--out", o.out, "Output folder (written as a whole or not at all)");
     c->add_option("--width", o.width, "Override every view's width in pixels")->check(CLI::Range(1, 1 << 30));
     c->add_option("--height", o.height, "Override every view's height in pixels")->check(CLI::Range(1, 1 << 30));
-    c->add_option("--depth-format", o.depthFormat, "Override every view's depth format (e.g. f32, unorm24)");
+    c->add_option("--depth-format", o.depthFormat,
+                  "Override every view's depth format (e.g. f32, unorm24, f32_reversed, log24:C=0.001)");
     c->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
     c->add_option("--max-resolution", o.maxResolution, "Largest width or height accepted (default 16384)")
         ->check(CLI::Range(1, 1 << 20));
@@ -896,6 +931,9 @@ void addAnalyzeOptions(CLI::App *c, Options &o) {
     effect("--abuffer", "--no-abuffer", o.abuffer, "the A-buffer");
     c->add_option("--max-depth", o.maxDepth, "Deepest secondary ray (reflection/refraction recursion)")
         ->check(CLI::Range(0, 255));
+    c->add_option("--zfight-formats", o.zfightFormats,
+                  "Depth formats the z-fighting analysis evaluates per view: comma-separated, or all (default: the "
+                  "twelve classic formats; each view's own format is always added)");
     c->add_option("--zfight-min-area", o.zfightMinArea, "Smallest hotspot, in pixels (smaller clusters still count as fighting pixels)")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     c->add_flag("--quiet", o.quiet, "No progress or summary on the console");
@@ -921,7 +959,7 @@ const Command kCommands[] = {
     {"grade", "Score a student's per-stage counts against a reference report (exit 1 on any failure)",
      addGradeOptions, cmdGrade},
     {"merge", "Join the reports of analyze --shard K/N runs into one report", addMergeOptions, cmdMerge},
-    {"depth-audit", "Per depth format: resolution against distance, distinct values, where 1 cm / 1 mm fight",
+    {"depth-audit", "Per depth format: resolution against distance, distinct values, from where 1 cm / 1 mm can fight",
      addDepthAuditOptions, cmdDepthAudit},
     {"pvs-audit", "Audit every cluster of a Quake 3 map's PVS: clusters seen yet hidden (misses), visible yet never seen "
                   "(slack)",

@@ -58,13 +58,25 @@ inline double encodeDepth(const DepthEncoder &e, double d, uint32_t &key, bool &
         return v;
     }
     case DepthFormat::unorm16:
-    case DepthFormat::unorm24: {
+    case DepthFormat::unorm24:
+    case DepthFormat::depth24plus: {  // WebGPU's depth24plus as its 24-bit implementation
         const double dc = clampDepth(d, n, f, oor);
         const double z = (f * (dc - n)) / (dc * (f - n));
         const double scale = F == DepthFormat::unorm16 ? 65535.0 : 16777215.0;
         double v = std::nearbyint(scale * z);  // round half to even (default rounding mode)
         v = v < 0 ? 0 : (v > scale ? scale : v);
         key = uint32_t(v);
+        return v;
+    }
+    case DepthFormat::unorm16_reversed:
+    case DepthFormat::unorm24_reversed: {
+        // Reversed-Z on an integer buffer: z_rev = n(f-d)/(d(f-n)) = 1 - z, rounded like unorm*.
+        const double dc = clampDepth(d, n, f, oor);
+        const double z = (n * (f - dc)) / (dc * (f - n));
+        const double scale = F == DepthFormat::unorm16_reversed ? 65535.0 : 16777215.0;
+        double v = std::nearbyint(scale * z);
+        v = v < 0 ? 0 : (v > scale ? scale : v);
+        key = uint32_t(scale - v);  // nearer is larger
         return v;
     }
     case DepthFormat::unorm24_gl: {
@@ -78,7 +90,25 @@ inline double encodeDepth(const DepthEncoder &e, double d, uint32_t &key, bool &
         key = uint32_t(v);
         return v;
     }
-    case DepthFormat::f32: {
+    case DepthFormat::f32_gl: {
+        // As unorm24_gl up to the window depth w, which a float buffer stores as it is.
+        const double dc = clampDepth(d, n, f, oor);
+        const float zndc = float((f + n) / (f - n) - (2 * f * n) / ((f - n) * dc));
+        const float w = zndc * 0.5f + 0.5f;  // in [0, 1]: z_ndc >= -1 gives +0.0 at near
+        key = floatBits(w);
+        return w;
+    }
+    case DepthFormat::f32_gl_reversed: {
+        // Reversed-Z without clip control: the projection's z row negated, so z_ndc runs from +1
+        // at near to -1 at far, and the same viewport transform w = 0.5 z_ndc + 0.5 (GREATER test).
+        const double dc = clampDepth(d, n, f, oor);
+        const float zndc = float((2 * f * n) / ((f - n) * dc) - (f + n) / (f - n));
+        const float w = zndc * 0.5f + 0.5f;
+        key = ~floatBits(w);
+        return w;
+    }
+    case DepthFormat::f32:
+    case DepthFormat::depth32float: {  // WebGPU's depth32float: f32 with the standard [0, 1] projection
         const double dc = clampDepth(d, n, f, oor);
         const float v = float((f * (dc - n)) / (dc * (f - n)));
         key = floatBits(v);
@@ -97,7 +127,8 @@ inline double encodeDepth(const DepthEncoder &e, double d, uint32_t &key, bool &
     }
     case DepthFormat::log24: {
         const double dc = clampDepth(d, n, f, oor);
-        double v = std::nearbyint(16777215.0 * (std::log(kLogDepthC * dc + 1) / e.logDenominator));
+        // e.logC is exactly 1 for plain log24, so 1 * dc is dc: the values log24 always stored.
+        double v = std::nearbyint(16777215.0 * (std::log(e.logC * dc + 1) / e.logDenominator));
         v = v < 0 ? 0 : (v > 16777215.0 ? 16777215.0 : v);
         key = uint32_t(v);
         return v;
@@ -123,6 +154,14 @@ inline auto dispatchDepthFormat(DepthFormat f, Fn &&fn) {
     case DepthFormat::f32_reversed: return fn.template operator()<DepthFormat::f32_reversed>();
     case DepthFormat::f32_reversed_inf: return fn.template operator()<DepthFormat::f32_reversed_inf>();
     case DepthFormat::log24: return fn.template operator()<DepthFormat::log24>();
+    case DepthFormat::unorm16_reversed: return fn.template operator()<DepthFormat::unorm16_reversed>();
+    case DepthFormat::unorm24_reversed: return fn.template operator()<DepthFormat::unorm24_reversed>();
+    case DepthFormat::f32_gl: return fn.template operator()<DepthFormat::f32_gl>();
+    case DepthFormat::f32_gl_reversed: return fn.template operator()<DepthFormat::f32_gl_reversed>();
+    // Same arithmetic, so the same instantiation (no extra rasterizer kernels): encodeDepth
+    // depends on F only through the arithmetic.
+    case DepthFormat::depth32float: return fn.template operator()<DepthFormat::f32>();
+    case DepthFormat::depth24plus: return fn.template operator()<DepthFormat::unorm24>();
     }
     return fn.template operator()<DepthFormat::f32>();
 }

@@ -77,7 +77,7 @@ bool readLimits(const json::Doc &doc, const json::Path &p, const json::Json &obj
             return false;
         }
         if (m->isFormat) {
-            DepthFormat f;
+            DepthFormatSpec f;
             std::string e;
             if (!value.is_string() || !parseDepthFormat(value.get<std::string>(), &f, &e)) {
                 *err = json::where(doc, p / key) + ": " + json::pathString(p / key) + ": " +
@@ -201,6 +201,26 @@ bool loadBudget(const std::string &path, const std::vector<std::string> &viewNam
     return true;
 }
 
+std::vector<DepthFormatSpec> budgetDepthFormats(const Budget &budget) {
+    std::vector<DepthFormatSpec> out;
+    auto add = [&](const DepthFormatSpec &f) {
+        if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
+    };
+    auto scan = [&](const std::map<std::string, nlohmann::json> &limits) {
+        for (const auto &[metric, value] : limits) {
+            const BudgetMetric *m = findMetric(metric);
+            DepthFormatSpec f;
+            if (!m || !m->isFormat || !value.is_string() || !parseDepthFormat(value.get<std::string>(), &f, nullptr))
+                continue;
+            add(f);
+            if (f.format == DepthFormat::depth24plus) add(DepthFormat::depth32float);
+        }
+    };
+    scan(budget.limits);
+    for (const auto &[view, limits] : budget.views) scan(limits);
+    return out;
+}
+
 bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *baseline, BudgetResult *out,
                     std::string *err) {
     BudgetResult r;
@@ -235,20 +255,32 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
             c.metric = m.name;
             c.kind = "limit";
             if (m.isFormat) {
-                // The view must fight nowhere in the named format.
-                const std::string f = lim->second.get<std::string>();
+                // The view must fight nowhere in the named format (read under its canonical name:
+                // "log24:C=1" is log24). depth24plus must hold on every implementation WebGPU allows:
+                // its 24-bit one (the depth24plus row) and depth32float.
+                DepthFormatSpec spec;
+                parseDepthFormat(lim->second.get<std::string>(), &spec, nullptr);  // validated by loadBudget
+                const std::string f = depthFormatName(spec);
+                std::vector<std::string> rows = {f};
+                if (spec.format == DepthFormat::depth24plus) rows.push_back("depth32float");
                 const OJson *formats = view.contains("depth") ? &view["depth"]["formats"] : nullptr;
-                if (!formats || !formats->contains(f)) {
-                    *err = budget.file + ": min_depth_format needs " + std::string(sectionFor(m.name)) +
-                           ", which the report of view '" + name + "' does not have";
-                    return false;
+                double px = 0;
+                for (const std::string &row : rows) {
+                    if (!formats || !formats->contains(row)) {
+                        *err = budget.file + ": min_depth_format needs " + std::string(sectionFor(m.name)) +
+                               " with " + row + ", which the report of view '" + name +
+                               "' does not have (run check with this budget, or analyze with --zfight-formats " +
+                               row + ")";
+                        return false;
+                    }
+                    px = std::max(px, (*formats)[row]["fighting_pixels"].get<double>());
                 }
-                const double px = (*formats)[f]["fighting_pixels"].get<double>();
-                c.value = fmt(px) + " fighting pixels in " + f;
+                const std::string in = rows.size() > 1 ? f + " (24-bit and depth32float)" : f;
+                c.value = fmt(px) + " fighting pixels in " + in;
                 c.allowed = "0 in " + f;
                 c.pass = px == 0;
                 if (!c.pass)
-                    c.message = "view '" + name + "' z-fights in " + f + " at " + fmt(px) + " pixels; it needs " +
+                    c.message = "view '" + name + "' z-fights in " + in + " at " + fmt(px) + " pixels; it needs " +
                                 (view["depth"]["recommended_format"].is_string()
                                      ? "at least " + view["depth"]["recommended_format"].get<std::string>()
                                      : std::string("a depth bias (it fights in every format)"));

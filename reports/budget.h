@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "render/depth_format.h"
+
 namespace va {
 
 constexpr const char *kBudgetFormat = "visaudit-budget/1";
@@ -34,6 +36,11 @@ struct Budget {
 // Reads and validates a budget file: format "visaudit-budget/1", known metric names, limit types,
 // view names that exist in `viewNames`, depth format names. Messages: FILE:LINE:COL: place: what; fix.
 bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err);
+
+// The depth formats a budget's min_depth_format limits name (each once, in file order; with
+// depth24plus also depth32float, WebGPU's other implementation of it): the z-fighting analysis
+// must evaluate them for the budget to be checked.
+std::vector<DepthFormatSpec> budgetDepthFormats(const Budget &budget);
 
 // One budget applied to one view.
 struct BudgetCheck {

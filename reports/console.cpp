@@ -23,7 +23,7 @@ std::string millis(double v) { return std::isfinite(v) ? format("%.1f", v) : std
 std::string funnelTable(const ViewResult &v) {
     const CameraSpec &c = v.spec.camera;
     std::string out = format("view '%s' %dx%d %s %s\n", v.spec.name.c_str(), c.width, c.height,
-                             depthFormatInfo(v.spec.depthFormat).name, c.orthographic ? "orthographic" : "perspective");
+                             depthFormatName(v.spec.depthFormat).c_str(), c.orthographic ? "orthographic" : "perspective");
     // Columns: stage (10, left), status (7, left), three counts (11, right), ms (9, right).
     out += format("  %-10s %-7s %11s %11s %11s %9s\n", "stage", "status", "tris in", "culled", "out", "ms");
     for (const StageRecord &s : v.stages) {

@@ -19,6 +19,7 @@ std::string format(const char *fmt, auto... args) {
 }
 
 std::string g3(double v) { return format("%.3g", v); }
+std::string g5(double v) { return format("%.5g", v); }  // the exact fight distances: 129.53
 std::string g6(double v) { return format("%.6g", v); }  // depths in headers: 10000, not 1e+04
 
 // "1cm", "1mm", "2.5cm", "1m": the gap in the unit that makes it a small number.
@@ -56,7 +57,10 @@ std::string depthAuditTable(const DepthAuditResult &r) {
     for (const DepthFormatAudit &a : r.formats) rangeW = std::max(rangeW, rangeLabel(r, a).size());
     out += format("%-17s %4s %12s  %-*s", "format", "bits", "distinct", int(rangeW), "range");
     for (double d : r.decadeDepths) out += format(" %9s", format("d=%s", g6(d).c_str()).c_str());
-    for (double g : r.fightGaps) out += format(" %10s", format("fight %s", gapLabel(g).c_str()).c_str());
+    for (double g : r.fightGaps) {
+        out += format(" %11s", format("onset %s", gapLabel(g).c_str()).c_str());
+        out += format(" %11s", format("likely %s", gapLabel(g).c_str()).c_str());
+    }
     out += "\n";
     bool anySkip = false, anyOut = false;
     for (const DepthFormatAudit &a : r.formats) {
@@ -69,13 +73,21 @@ std::string depthAuditTable(const DepthAuditResult &r) {
             anyOut |= !s.inRange;
             out += format(" %9s", cell.c_str());
         }
-        for (const DepthFightDistance &f : a.fights)
-            out += format(" %10s", f.distance ? g3(*f.distance).c_str() : "never");
+        for (const DepthFightDistance &f : a.fights) {
+            out += format(" %11s", f.onset ? g5(*f.onset).c_str() : "never");
+            out += format(" %11s", f.likely ? g5(*f.likely).c_str() : "never");
+        }
         out += "\n";
     }
-    out += "fight <gap>: smallest depth (m) where two surfaces <gap> apart store the same value; never: not up to far\n";
+    out += "onset <gap>: smallest depth (m) where a stored value's bucket is wider than <gap>, so two surfaces <gap> "
+           "apart can store the same value (exact)\n";
+    out += "likely <gap>: smallest depth (m) where a bucket is at least 2 x <gap> wide: a pair <gap> apart there "
+           "shares a value with probability >= 50%\n";
+    out += "never: no bucket up to far is that wide\n";
     if (anyOut) out += "-: depth outside the format's range (range column); it clamps to the range's end\n";
-    if (anySkip) out += "*: step limited by the double-precision depth input, not by the format (floats there are denser)\n";
+    if (anySkip)
+        out += "*: the next value produced is more than one stored value away: the floats there are denser than what "
+               "feeds them (the double depth, or the OpenGL formats' float z_ndc), which sets the step\n";
     for (const DepthFormatAudit &a : r.formats)
         if (!a.rangeNote.empty()) out += a.name + ": " + a.rangeNote + "\n";
     return out;
@@ -101,12 +113,13 @@ Json depthAuditJson(const DepthAuditResult &r) {
     j["curve_depths"] = curve;
     Json formats = Json::array();
     for (const DepthFormatAudit &a : r.formats) {
-        const DepthFormatInfo &info = depthFormatInfo(a.format);
+        const DepthFormatInfo &info = depthFormatInfo(a.format.format);
         Json f;
         f["name"] = a.name;
         f["bits"] = a.bits;
         f["nearer_is"] = a.nearerIsLarger ? "larger" : "smaller";
         f["stored"] = info.stored;
+        if (a.format.format == DepthFormat::log24) f["log_c"] = num(a.format.logC);
         f["distinct_values"] = a.distinctValues;
         f["representable"] = {{"near", num(a.representableNear)},
                               {"far", num(a.representableFar)},
@@ -129,7 +142,11 @@ Json depthAuditJson(const DepthAuditResult &r) {
         }
         f["resolution"] = std::move(res);
         Json fights = Json::array();
-        for (const DepthFightDistance &d : a.fights) fights.push_back({{"gap", num(d.gap)}, {"distance", num(d.distance)}});
+        for (const DepthFightDistance &d : a.fights)
+            fights.push_back({{"gap", num(d.gap)},
+                              {"onset", num(d.onset)},
+                              {"onset_bucket_width", num(d.onsetBucket)},
+                              {"likely", num(d.likely)}});
         f["fight_distances"] = std::move(fights);
         Json c = Json::array();
         for (const std::optional<double> &v : a.curveResolution) c.push_back(num(v));

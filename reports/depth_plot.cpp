@@ -26,6 +26,18 @@ constexpr int kScale = 2;
 constexpr Rgb8 kText{20, 20, 20};
 constexpr Rgb8 kFrame{60, 60, 60};
 constexpr Rgb8 kGrid{215, 215, 215};
+constexpr Rgb8 kGapLine{150, 150, 150};
+constexpr Rgb8 kGapText{110, 110, 110};
+
+// "1CM", "1MM", "2.5CM", "1M": a gap in the unit that makes it a small number (upper case: the
+// plot's titles are).
+std::string gapText(double g) {
+    char buf[32];
+    if (g >= 1) std::snprintf(buf, sizeof buf, "%gM", g);
+    else if (g >= 0.01) std::snprintf(buf, sizeof buf, "%gCM", g * 100);
+    else std::snprintf(buf, sizeof buf, "%gMM", g * 1000);
+    return buf;
+}
 
 // The same protocol as reports/images.cpp: write to PATH.tmp-PID-N, then rename over PATH (atomic
 // within one folder), so a reader never sees half a PNG; the temporary file is removed on failure.
@@ -96,12 +108,19 @@ std::string shortNumber(double v) {
 }  // namespace
 
 Rgb8 depthPlotColor(DepthFormat format) {
-    // Tableau's 10 categorical colors, then black and navy: all readable on white.
+    // Tableau's 10 categorical colors, then black and navy (the first twelve formats), then six
+    // darker ones for the formats issue 19 added: all readable on white, pairwise distinct.
     static constexpr Rgb8 kPalette[kDepthFormatCount] = {
         {31, 119, 180}, {255, 127, 14}, {44, 160, 44},   {214, 39, 40},  {148, 103, 189}, {140, 86, 75},
         {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}, {0, 0, 0},       {0, 0, 150},
+        {128, 0, 0},    {0, 100, 0},    {255, 0, 255},   {153, 102, 0},  {0, 128, 128},   {102, 0, 204},
     };
     return kPalette[int(format) % kDepthFormatCount];
+}
+
+Rgb8 depthPlotColor(const DepthFormatSpec &format) {
+    if (format.format == DepthFormat::log24 && format.logC != kLogDepthC) return {90, 90, 0};  // log24:C=X
+    return depthPlotColor(format.format);
 }
 
 int DepthPlotLayout::xOf(double d) const {
@@ -193,6 +212,21 @@ bool writeDepthResolutionPlot(const DepthAuditResult &r, const std::string &path
     c.rect(L.left, L.top, L.left, L.bottom, kFrame);
     c.rect(L.right, L.top, L.right, L.bottom, kFrame);
 
+    // The fight distances (analysis/depth_audit.h), under the curves: a dashed line at each gap and
+    // at twice each gap (where a curve crosses them, buckets get wider than the gap: the onset;
+    // twice as wide: likely).
+    auto dashed = [&](double value, const std::string &label) {
+        if (!(value > 0)) return;
+        const int y = L.yOf(value);
+        if (y <= L.top || y >= L.bottom) return;
+        for (int x = L.left + 1; x < L.right; ++x)
+            if ((x / 6) % 2 == 0) c.set(x, y, kGapLine);
+        c.text(L.left + 6, y - glyphH - 3, label, kGapText);
+    };
+    for (double g : r.fightGaps) {
+        dashed(g, "GAP " + gapText(g));
+        dashed(2 * g, "2 X GAP " + gapText(g));
+    }
     // Curves, in the result's order (later ones over earlier ones where they coincide).
     for (const DepthFormatAudit &a : r.formats) {
         const Rgb8 col = depthPlotColor(a.format);
@@ -212,6 +246,24 @@ bool writeDepthResolutionPlot(const DepthAuditResult &r, const std::string &path
             havePrev = true;
         }
     }
+
+    // Markers of the fight distances, over the curves: per format a filled square at (onset, gap)
+    // and a hollow one at (likely, 2 x gap).
+    auto square = [&](double d, double value, Rgb8 col, bool filled) {
+        if (!(d >= r.nearZ && d <= r.farZ) || !(value > 0)) return;
+        const int x = L.xOf(d), y = L.yOf(value);
+        for (int oy = -4; oy <= 4; ++oy)
+            for (int ox = -4; ox <= 4; ++ox) {
+                const bool edge = std::abs(ox) >= 3 || std::abs(oy) >= 3;
+                const int px = x + ox, py = y + oy;
+                if ((filled || edge) && px > L.left && px < L.right && py > L.top && py < L.bottom) c.set(px, py, col);
+            }
+    };
+    for (const DepthFormatAudit &a : r.formats)
+        for (const DepthFightDistance &f : a.fights) {
+            if (f.onset) square(*f.onset, f.gap, depthPlotColor(a.format), true);
+            if (f.likely) square(*f.likely, 2 * f.gap, depthPlotColor(a.format), false);
+        }
 
     // Legend: a colored bar and the name in the same color, one row per format.
     int ly = L.top;

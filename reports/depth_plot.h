@@ -25,15 +25,19 @@ struct DepthPlotLayout {
 // at least one positive finite curve value).
 DepthPlotLayout depthPlotLayout(const DepthAuditResult &result);
 
-// A format's curve color: fixed per format (the same in every plot), 12 distinct colors.
+// A format's curve color: fixed per format (the same in every plot), 18 distinct colors; every
+// log24:C=X with C != 1 shares one more (dark olive).
 Rgb8 depthPlotColor(DepthFormat format);
+Rgb8 depthPlotColor(const DepthFormatSpec &format);
 constexpr Rgb8 kDepthPlotBackground{255, 255, 255};
 
 // Writes a width x height RGB PNG at `path` (temporary name in the same folder, then renamed):
 // resolution (m) against view depth d (m) on log-log axes, decade grid lines with labelled ticks,
 // one colored curve per format through its dense curve (DepthFormatAudit::curveResolution at
-// DepthAuditResult::curveDepths; absent samples break the curve), a legend of the format names in
-// their colors, axis titles, in the bitmap font of reports/font.h. Integer formats draw as steps.
+// DepthAuditResult::curveDepths; absent samples break the curve), dashed grey lines at each fight
+// gap and at twice it with, per format, a filled 9x9 square at (onset, gap) and a hollow one at
+// (likely, 2 x gap) in its color, a legend of the format names in their colors, axis titles, in
+// the bitmap font of reports/font.h. Integer formats draw as steps.
 // Returns false with *err (the path and the reason) when the result has an error or nothing to
 // plot, or the file cannot be written.
 bool writeDepthResolutionPlot(const DepthAuditResult &result, const std::string &path, std::string *err);

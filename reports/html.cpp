@@ -902,7 +902,7 @@ std::optional<double> methodMs(const Json *row) {
 struct HtmlWriter {
     const Json &report;
     Folder folder;
-    std::map<std::pair<double, double>, DepthAuditResult> audits;  // by (near, far)
+    std::map<std::pair<std::pair<double, double>, std::string>, DepthAuditResult> audits;  // by (near, far), formats
     std::string o;
 
     void header(const std::vector<ViewScore> &worstFirst);
@@ -1215,7 +1215,7 @@ void HtmlWriter::hotspots(const Json *v, const std::string &id, const std::vecto
     }
     o += ".</p><div class=\"scroll\"><table class=\"hotspots\"><tr><th>id</th><th class=\"n\">area (px)</th>"
          "<th>pixels (bbox)</th><th>world position</th><th class=\"n\">depth</th><th>objects</th><th class=\"n\">gap</th>"
-         "<th>fights in</th></tr>";
+         "<th>fights in</th><th>why</th></tr>";
     for (const Json &h : *hs) {
         const std::string hid = fmtValue(get(&h, "id"));
         o += "<tr><td>" + hid + "</td><td class=\"n\">" + fmtValue(get(&h, "area")) + "</td><td>";
@@ -1242,7 +1242,8 @@ void HtmlWriter::hotspots(const Json *v, const std::string &id, const std::vecto
                 o += f;
             }
         }
-        o += "</td></tr>";
+        // Why: the gap against the view format's bucket there, and the cheapest format that orders it.
+        o += "</td><td>" + esc(str(&h, {"why"})) + "</td></tr>";
     }
     o += "</table></div>";
 }
@@ -1498,9 +1499,18 @@ void HtmlWriter::depthFormats(const Json *v, const std::string &id) {
     const auto nearZ = num(v, {"camera", "near"}), farZ = num(v, {"camera", "far"});
     std::string err;
     if (!nearZ || !farZ || !validateDepthAuditRange(*nearZ, *farZ, &err)) return;
-    auto key = std::make_pair(*nearZ, *farZ);
+    // The formats the view's z-fighting table holds (default: the classic twelve), in its order.
+    std::vector<DepthFormatSpec> specs;
+    std::string names;
+    if (fmts && fmts->is_object())
+        for (auto f = fmts->begin(); f != fmts->end(); ++f) {
+            DepthFormatSpec spec;
+            if (parseDepthFormat(f.key(), &spec, nullptr)) specs.push_back(spec), names += f.key() + ",";
+        }
+    if (specs.empty()) specs.assign(defaultZFightFormats().begin(), defaultZFightFormats().end());
+    auto key = std::make_pair(std::make_pair(*nearZ, *farZ), names);
     auto it = audits.find(key);
-    if (it == audits.end()) it = audits.emplace(key, auditDepthFormats(*nearZ, *farZ, allDepthFormats())).first;
+    if (it == audits.end()) it = audits.emplace(key, auditDepthFormats(*nearZ, *farZ, specs)).first;
     if (!it->second.error.empty()) return;
     std::vector<std::pair<std::string, double>> markers;
     if (const Json *hs = get(d, "hotspots"); hs && hs->is_array())

@@ -540,14 +540,14 @@ Json depthJson(const ZFightResult &z, double ms) {
                            {"out_of_range_pixels", f.outOfRangePixels}};
     }
     j["formats"] = formats;
-    j["recommended_format"] = z.recommended ? Json(depthFormatInfo(*z.recommended).name) : Json(nullptr);
+    j["recommended_format"] = z.recommended ? Json(depthFormatName(*z.recommended)) : Json(nullptr);
     j["recommendation"] = z.recommendation;
     j["hotspot_count"] = z.hotspotCount;
     Json hs = Json::array();
     for (const ZFightHotspot &h : z.hotspots) {
         Json fj = Json::array();
         for (const ZFightHotspotFormat &f : h.formats)
-            fj.push_back({{"name", depthFormatInfo(f.format).name}, {"pixels", f.pixels}});
+            fj.push_back({{"name", depthFormatName(f.format)}, {"pixels", f.pixels}});
         hs.push_back({{"id", h.id},
                       {"area", h.area},
                       {"bbox", {h.minX, h.minY, h.maxX, h.maxY}},
@@ -560,7 +560,13 @@ Json depthJson(const ZFightResult &z, double ms) {
                       {"triangles", {h.triangleA, h.triangleB}},
                       {"pair_pixels", h.pairPixels},
                       {"pairs", h.pairs},
-                      {"formats", fj}});
+                      {"formats", fj},
+                      // Why it fights (analysis/zfight.h explainHotspot; docs/zfighting.md).
+                      {"view_bucket_width", h.viewBucketWidth ? num(*h.viewBucketWidth) : Json(nullptr)},
+                      {"cheapest_format",
+                       h.cheapestFormat ? Json(depthFormatInfo(*h.cheapestFormat).name) : Json(nullptr)},
+                      {"cheapest_bucket_width", h.cheapestBucketWidth ? num(*h.cheapestBucketWidth) : Json(nullptr)},
+                      {"why", h.why}});
     }
     j["hotspots"] = hs;
     j["ms"] = num(ms);
@@ -685,7 +691,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
         vj["origin"] = v.spec.origin;
         vj["width"] = v.spec.camera.width;
         vj["height"] = v.spec.camera.height;
-        vj["depth_format"] = depthFormatInfo(v.spec.depthFormat).name;
+        vj["depth_format"] = depthFormatName(v.spec.depthFormat);
         vj["projection"] = v.spec.camera.orthographic ? "orthographic" : "perspective";
         vj["camera"] = cameraJson(v.spec.camera);
         Json stages = Json::array();

@@ -111,7 +111,7 @@ void auditView(const Scene &scene, const ObjectBvh &bvh, const ViewSpec &spec, c
     std::string err;
     ASSERT_TRUE(makeCamera(spec.camera, &cam, &err)) << what << ": " << err;
     const ReferenceVisibility ref = referenceVisibility(scene, cam);
-    const ViewRun run = runView(scene, bvh, cam, spec.depthFormat);
+    const ViewRun run = runView(scene, bvh, cam, spec.depthFormat.format);
     const CullAudit a = auditCulling(scene, ref, {{"frustum", run.frustumCulled, {}}, {"backface", {}, run.backfaceCulled}},
                                      run.kept.triangles, &run.fragmentsPerSource);
     ASSERT_EQ(a.stages.size(), 2u);

@@ -169,7 +169,9 @@ TEST(DepthFormat, ParseListsKnownFormats) {
     EXPECT_FALSE(parseDepthFormat("d24s8", &f, &err));
     EXPECT_EQ(err,
               "unknown depth format 'd24s8'; known formats: linear_f32 inv_f32 int31_inv uint32_inv "
-              "uint32_inv1 unorm16 unorm24 unorm24_gl f32 f32_reversed f32_reversed_inf log24");
+              "uint32_inv1 unorm16 unorm24 unorm24_gl f32 f32_reversed f32_reversed_inf log24 unorm16_reversed "
+              "unorm24_reversed f32_gl f32_gl_reversed depth32float depth24plus, and log24:C=X (log24 with "
+              "constant C = X > 0)");
     EXPECT_EQ(f, DepthFormat::unorm24_gl);  // untouched on failure
     // Every name in the table parses back to its format.
     for (DepthFormat g : allDepthFormats()) {

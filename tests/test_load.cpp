@@ -365,7 +365,9 @@ TEST(LoadScene, ViewErrors) {
          "5:52: views[0].height: expected a whole number of pixels, got 10.5"},
         {"{ \"eye\": [0, 0, 5], \"target\": [0, 0, 0], \"depth_format\": \"d24s8\" }",
          "5:58: views[0].depth_format: unknown depth format 'd24s8'; known formats: linear_f32 inv_f32 int31_inv "
-         "uint32_inv uint32_inv1 unorm16 unorm24 unorm24_gl f32 f32_reversed f32_reversed_inf log24"},
+         "uint32_inv uint32_inv1 unorm16 unorm24 unorm24_gl f32 f32_reversed f32_reversed_inf log24 unorm16_reversed "
+         "unorm24_reversed f32_gl f32_gl_reversed depth32float depth24plus, and log24:C=X (log24 with constant "
+         "C = X > 0)"},
         {"{ \"eye\": [0, 1e999, 5], \"target\": [0, 0, 0] }",
          "5:14: JSON error: number overflow parsing '1e999' (the number does not fit a double)"},
         {"{ \"eye\": [0, 0, 5] }",

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <ctime>
 #include <iterator>
+#include <regex>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -26,8 +27,9 @@ using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
 // ---- A small JSON Schema validator (the subset docs/report-schema.json uses) ------------------
-// Keywords: $ref (local "#/$defs/NAME"), type (string or array), const, enum, minimum, required,
-// properties, additionalProperties (false or a schema), items, minItems, maxItems, maximum.
+// Keywords: $ref (local "#/$defs/NAME"), type (string or array), const, enum, pattern (ECMAScript,
+// searched), minimum, maximum, required, properties, additionalProperties (false or a schema),
+// items, minItems, maxItems.
 
 bool typeMatches(const std::string &t, const Json &v) {
     if (t == "object") return v.is_object();
@@ -45,7 +47,7 @@ void validate(const Json &root, const Json &schema, const Json &v, const std::st
               std::vector<std::string> *errors) {
     static const std::vector<std::string> kKnown = {
         "$schema", "$id", "title", "description", "$ref", "type", "const", "enum", "minimum", "maximum", "required",
-        "properties", "additionalProperties", "items", "minItems", "maxItems", "$defs"};
+        "properties", "additionalProperties", "items", "minItems", "maxItems", "$defs", "pattern"};
     for (auto it = schema.begin(); it != schema.end(); ++it)
         if (std::find(kKnown.begin(), kKnown.end(), it.key()) == kKnown.end())
             errors->push_back(where + ": validator does not know keyword '" + it.key() + "'");
@@ -72,6 +74,9 @@ void validate(const Json &root, const Json &schema, const Json &v, const std::st
         errors->push_back(where + ": expected " + schema["const"].dump() + ", got " + v.dump());
     if (schema.contains("enum") && std::find(schema["enum"].begin(), schema["enum"].end(), v) == schema["enum"].end())
         errors->push_back(where + ": " + v.dump() + " not in enum");
+    if (schema.contains("pattern") && v.is_string() &&
+        !std::regex_search(v.get<std::string>(), std::regex(schema["pattern"].get<std::string>())))
+        errors->push_back(where + ": " + v.dump() + " does not match " + schema["pattern"].dump());
     if (schema.contains("minimum") && v.is_number() && v.get<double>() < schema["minimum"].get<double>())
         errors->push_back(where + ": " + v.dump() + " below minimum");
     if (schema.contains("maximum") && v.is_number() && v.get<double>() > schema["maximum"].get<double>())

@@ -96,7 +96,7 @@ const ZFightFormatStats &stats(const ZFightResult &r, DepthFormat f) {
 
 std::set<DepthFormat> formatsOf(const ZFightHotspot &h) {
     std::set<DepthFormat> s;
-    for (const ZFightHotspotFormat &f : h.formats) s.insert(f.format);
+    for (const ZFightHotspotFormat &f : h.formats) s.insert(f.format.format);
     return s;
 }
 
@@ -235,7 +235,7 @@ TEST(ZFightCases, CoplanarDuplicateFightsInEveryFormat) {
     EXPECT_EQ(r.coveredPixels, 64u);
     EXPECT_EQ(r.twoSurfacePixels, 64u);
     EXPECT_EQ(r.coplanarPixels, 64u);
-    ASSERT_EQ(r.perFormat.size(), size_t(kDepthFormatCount));
+    ASSERT_EQ(r.perFormat.size(), size_t(kClassicDepthFormatCount));  // the default set
     for (const ZFightFormatStats &s : r.perFormat) {
         EXPECT_EQ(s.fightingPixels, 64u) << s.name;
         EXPECT_EQ(s.coplanarPixels, 64u) << s.name;
@@ -256,7 +256,7 @@ TEST(ZFightCases, CoplanarDuplicateFightsInEveryFormat) {
     EXPECT_NEAR(h.centroid.x, 0, 1e-12);
     EXPECT_NEAR(h.centroid.y, 0, 1e-12);
     EXPECT_NEAR(h.centroid.z, 0, 1e-12);
-    EXPECT_EQ(h.formats.size(), size_t(kDepthFormatCount));
+    EXPECT_EQ(h.formats.size(), size_t(kClassicDepthFormatCount));
     EXPECT_EQ(std::set<std::string>({h.objectA, h.objectB}), std::set<std::string>({"tile", "copy"}));
     EXPECT_EQ(h.pairs, 2u);  // tile triangle k over copy triangle k, k = 0, 1
     // Coplanar surfaces do not decide the format (no format orders them): nothing else fights, so
@@ -292,7 +292,7 @@ TEST(ZFightCases, DecalOneMillimeterAboveFloorAt100m) {
     const std::set<DepthFormat> fighting = {DepthFormat::unorm16, DepthFormat::unorm24, DepthFormat::unorm24_gl,
                                             DepthFormat::f32};
     for (const ZFightFormatStats &s : r.perFormat) {
-        const uint64_t expected = fighting.count(s.format) ? 64 : 0;
+        const uint64_t expected = fighting.count(s.format.format) ? 64 : 0;
         EXPECT_EQ(s.fightingPixels, expected) << s.name;
         EXPECT_EQ(s.coplanarPixels, 0u) << s.name;
         EXPECT_EQ(s.hotspots, expected ? 1u : 0u) << s.name;
@@ -486,7 +486,7 @@ TEST(ZFightCases, WideRangeNear1e3Far1e6FormatsFollowTheirMath) {
         const std::set<DepthFormat> fighting = {DepthFormat::unorm16, DepthFormat::unorm24, DepthFormat::unorm24_gl,
                                                 DepthFormat::f32};
         for (const ZFightFormatStats &s : r.perFormat) {
-            EXPECT_EQ(s.fightingPixels, fighting.count(s.format) ? 64u : 0u) << s.name;
+            EXPECT_EQ(s.fightingPixels, fighting.count(s.format.format) ? 64u : 0u) << s.name;
             EXPECT_EQ(s.outOfRangePixels, 0u) << s.name;
         }
         ASSERT_EQ(r.hotspots.size(), 1u);
@@ -507,7 +507,7 @@ TEST(ZFightCases, WideRangeNear1e3Far1e6FormatsFollowTheirMath) {
         EXPECT_EQ(r.coveredPixels, 4096u);
         const std::set<DepthFormat> fighting = {DepthFormat::int31_inv, DepthFormat::uint32_inv, DepthFormat::unorm16};
         for (const ZFightFormatStats &s : r.perFormat) {
-            EXPECT_EQ(s.fightingPixels, fighting.count(s.format) ? 64u : 0u) << s.name;
+            EXPECT_EQ(s.fightingPixels, fighting.count(s.format.format) ? 64u : 0u) << s.name;
             const bool clampsBelow1 = s.format == DepthFormat::int31_inv || s.format == DepthFormat::uint32_inv;
             EXPECT_EQ(s.outOfRangePixels, clampsBelow1 ? 4096u : 0u) << s.name;
         }
@@ -608,7 +608,7 @@ TEST(ZFightDemo, CoplanarDecalIsAHotspotAtItsWorldPosition) {
     EXPECT_NE(r.recommendation.find("coplanar surfaces fight in every format"), std::string::npos);
     std::cout << "[ demo spawn ] hotspots " << r.hotspotCount << ", decal #" << decal->id << " area " << decal->area
               << " at (" << decal->centroid.x << ", " << decal->centroid.y << ", " << decal->centroid.z
-              << "), recommended " << depthFormatInfo(*r.recommended).name << ": " << r.recommendation << "\n";
+              << "), recommended " << depthFormatName(*r.recommended) << ": " << r.recommendation << "\n";
     for (const ZFightFormatStats &s : r.perFormat)
         std::cout << "  " << s.name << " fighting " << s.fightingPixels << " (coplanar " << s.coplanarPixels
                   << ") hotspots " << s.hotspots << " edge " << s.sharedEdgePixels << " intersection "
@@ -692,7 +692,7 @@ TEST(ZFightRealData, CastleDungeonOrbitViews) {
                   << r.twoSurfacePixels << ", fighting (any format) " << r.fightingPixelsAnyFormat << " = separated "
                   << r.separatedPixels << " + coplanar " << r.coplanarPixels << " + shared edge " << r.sharedEdgePixels
                   << " + intersection " << r.intersectionPixels << "; hotspots " << r.hotspotCount << "; recommended "
-                  << (r.recommended ? depthFormatInfo(*r.recommended).name : "none") << " (" << r.recommendation
+                  << (r.recommended ? depthFormatName(*r.recommended) : std::string("none")) << " (" << r.recommendation
                   << ")\n";
         for (const ZFightFormatStats &s : r.perFormat)
             std::cout << "    " << s.name << ": fighting " << s.fightingPixels << " (coplanar " << s.coplanarPixels
