@@ -51,6 +51,7 @@ struct Options {
     // Resource limits (docs/limits.md)
     int maxResolution = kDefaultMaxResolution;
     uint64_t maxTriangles = kDefaultMaxTriangles;
+    uint64_t maxJsonDepth = kDefaultMaxJsonDepth;
     int maxRecursion = kDefaultMaxRecursion;
     uint32_t maxABufferList = kDefaultMaxABufferList;
     std::string maxMemory;  // empty: defaultMaxMemory()
@@ -134,6 +135,7 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
         lo.chunks.maxTriangles = o.chunk;
         lo.bsp.patchLevel = o.patchLevel;
         lo.maxTriangles = o.maxTriangles;
+        lo.maxJsonDepth = o.maxJsonDepth;
         if (!loadScene(o.scene, lo, scene, &err)) {
             fail(err);
             return false;
@@ -642,6 +644,9 @@ void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("--max-triangles", o.maxTriangles,
                   "Largest scene accepted, in triangles (default 100000000; at most 4294967295, the 32-bit ids)")
         ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
+    c->add_option("--max-json-depth", o.maxJsonDepth,
+                  "Deepest nesting of arrays and objects accepted in a JSON input (default 512)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20));
 }
 
 void addAnalyzeOptions(CLI::App *c, Options &o) {
