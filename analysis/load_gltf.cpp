@@ -236,15 +236,12 @@ struct GltfLoader {
             *e = vw + " refers to buffer " + std::to_string(view.buffer) + ", which does not exist";
             return false;
         }
+        // A view that does not lie inside its buffer holds nothing: whatever reads it reads past its end
+        // (the reader's message says how many elements it wanted).
         const auto &buf = model.buffers[size_t(view.buffer)].data;
-        if (view.byteOffset > buf.size() || view.byteLength > buf.size() - view.byteOffset) {
-            *e = vw + " (" + std::to_string(view.byteLength) + " bytes at offset " + std::to_string(view.byteOffset) +
-                 ") lies past the end of buffer " + std::to_string(view.buffer) + " (" + std::to_string(buf.size()) +
-                 " bytes); the file is truncated or inconsistent";
-            return false;
-        }
-        *data = buf.data() + view.byteOffset;
-        *size = view.byteLength;
+        const bool inside = view.byteOffset <= buf.size() && view.byteLength <= buf.size() - view.byteOffset;
+        *data = inside ? buf.data() + view.byteOffset : buf.data();
+        *size = inside ? view.byteLength : 0;
         return true;
     }
 
@@ -424,6 +421,11 @@ struct GltfLoader {
             const unsigned char *data = nullptr;
             size_t size = 0;
             if (!viewData(int(bv), "KHR_draco_mesh_compression", &data, &size, e)) return false;
+            if (size < model.bufferViews[size_t(bv)].byteLength) {
+                *e = "KHR_draco_mesh_compression: buffer view " + std::to_string(bv) +
+                     " lies past the end of its buffer; the file is truncated or inconsistent";
+                return false;
+            }
             gltf::DracoMesh dm;
             std::string de;
             if (!gltf::decodeDraco(data, size, int(std::clamp<int64_t>(posId, -1, INT32_MAX)), &dm, &de)) {
