@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string_view>
 
 #include "analysis/json_util.h"
 
@@ -168,28 +169,44 @@ bool moveOutOfTinygltfsWay(Json &root, Source *out) {
     return changed;
 }
 
-}  // namespace
-
-JsonNesting jsonNesting(const char *text, size_t size, uint64_t limit) {
-    JsonNesting n;
-    uint64_t depth = 0;
-    for (size_t i = 0; i < size; ++i) {
+// The JSON nesting check every JSON input shares (issue 16). Branch i16a adds it to json_util as
+// json::checkDepth(text, file, maxDepth, err) with kMaxJsonDepthCeiling; this is the same function
+// and message, to be replaced by a call to it when both branches are merged.
+constexpr uint64_t kMaxJsonDepthCeiling = 2048;
+bool checkDepth(std::string_view text, const std::string &file, uint64_t maxDepth, std::string *err) {
+    // One pass, a counter instead of a stack: '[' and '{' open a level, ']' and '}' close one, and
+    // a string (from '"' to the next '"' not escaped by '\\') is skipped whole.
+    uint64_t depth = 0, deepest = 0;
+    size_t firstOver = std::string_view::npos;
+    for (size_t i = 0; i < text.size(); ++i) {
         const char c = text[i];
         if (c == '"') {
-            // Skip the string, escapes included; an unterminated string ends the scan (the parser
-            // reports it).
-            for (++i; i < size && text[i] != '"'; ++i)
+            for (++i; i < text.size() && text[i] != '"'; ++i)
                 if (text[i] == '\\') ++i;
         } else if (c == '[' || c == '{') {
-            ++depth;
-            if (depth > n.depth) n.depth = depth;
-            if (depth == limit + 1 && n.firstOver == std::string::npos) n.firstOver = i;
+            if (++depth > deepest) deepest = depth;
+            if (depth > maxDepth && firstOver == std::string_view::npos) firstOver = i;
         } else if ((c == ']' || c == '}') && depth > 0) {
             --depth;
         }
     }
-    return n;
+    if (firstOver == std::string_view::npos) return true;
+    size_t line = 1, lineStart = 0;
+    for (size_t i = 0; i < firstOver; ++i)
+        if (text[i] == '\n') ++line, lineStart = i + 1;
+    const size_t col = firstOver - lineStart + 1;
+    *err = file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": arrays and objects nested " +
+           std::to_string(deepest) + " levels deep, more than the limit of " + std::to_string(maxDepth) + "; ";
+    if (deepest <= kMaxJsonDepthCeiling)
+        *err += "raise it with --max-json-depth " + std::to_string(deepest) + " if the file is meant to nest so deep";
+    else
+        *err += "--max-json-depth accepts at most " + std::to_string(kMaxJsonDepthCeiling) +
+                " (no scene, views, glTF, budget or report file nests so deep): the file is damaged or was "
+                "made to exhaust a parser's stack";
+    return false;
 }
+
+}  // namespace
 
 bool prepareSource(const std::string &path, bool binary, uint64_t maxJsonDepth, Source *out, std::string *err) {
     auto fail = [&](const std::string &m) {
@@ -233,16 +250,8 @@ bool prepareSource(const std::string &path, bool binary, uint64_t maxJsonDepth, 
     const char *text = reinterpret_cast<const char *>(b) + jsonBegin;
 
     // Nesting before parsing: tinygltf converts extras and extensions recursively.
-    const JsonNesting nest = jsonNesting(text, jsonSize, maxJsonDepth);
-    if (nest.depth > maxJsonDepth) {
-        const std::string jsonText(text, std::min(jsonSize, nest.firstOver + 1));
-        size_t line = 0, col = 0;
-        json::lineCol(jsonText, nest.firstOver, &line, &col);
-        return fail(path + (binary ? ": JSON chunk " : ":") + std::to_string(line) + ":" + std::to_string(col) +
-                    ": JSON nested " + std::to_string(nest.depth) + " levels deep, more than the limit of " +
-                    std::to_string(maxJsonDepth) + "; raise it with --max-json-depth " + std::to_string(nest.depth) +
-                    ", or the file is damaged");
-    }
+    if (!checkDepth(std::string_view(text, jsonSize), binary ? path + " (JSON chunk)" : path, maxJsonDepth, err))
+        return false;
 
     Json root = Json::parse(text, text + jsonSize, nullptr, /*allow_exceptions=*/false);
     if (root.is_discarded() || !root.is_object()) return true;  // tinygltf says where the syntax is wrong

@@ -30,15 +30,6 @@ struct Source {
     std::vector<std::string> warnings;  // with the file name
 };
 
-// The deepest nesting of arrays and objects in JSON text (strings skipped), scanning without
-// recursion; `firstOver` is the byte offset of the first bracket that opens level limit + 1 (npos
-// when there is none).
-struct JsonNesting {
-    uint64_t depth = 0;
-    size_t firstOver = std::string::npos;
-};
-JsonNesting jsonNesting(const char *text, size_t size, uint64_t limit);
-
 // Reads `path` (.glb when `binary`) and prepares it for tinygltf. False with a message naming the file,
 // the place and a fix.
 bool prepareSource(const std::string &path, bool binary, uint64_t maxJsonDepth, Source *out, std::string *err);

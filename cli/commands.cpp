@@ -644,12 +644,12 @@ void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("--max-triangles", o.maxTriangles,
                   "Largest scene accepted, in triangles (default 100000000; at most 4294967295, the 32-bit ids)")
         ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
-    // At most 4096: tinygltf converts a glTF's extras and extensions recursively, about 0.5 KiB of
-    // stack per level (it overflowed the 8 MiB stack between 15000 and 20000 levels, Release build);
-    // 4096 levels use a quarter of it, leaving room for the sanitizers' larger frames.
+    // At most 2048 (branch i16a's json::kMaxJsonDepthCeiling): tinygltf converts a glTF's extras and
+    // extensions recursively, about 0.5 KiB of stack per level in Release (it overflowed the 8 MiB
+    // stack between 15000 and 20000 levels), several times that under the sanitizers.
     c->add_option("--max-json-depth", o.maxJsonDepth,
-                  "Deepest nesting of arrays and objects accepted in a JSON input (default 512, at most 4096)")
-        ->check(CLI::Range(uint64_t(1), uint64_t(4096)));
+                  "Deepest nesting of arrays and objects accepted in a JSON input (default 512, at most 2048)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(2048)));
 }
 
 void addAnalyzeOptions(CLI::App *c, Options &o) {
