@@ -10,7 +10,8 @@
 
 namespace va::gltf {
 
-bool decodeDraco(const unsigned char *data, size_t size, int positionId, DracoMesh *out, std::string *err) {
+bool decodeDraco(const unsigned char *data, size_t size, const std::map<std::string, std::pair<int, int>> &ids,
+                 DracoMesh *out, std::string *err) {
     // libdraco reports bad data through its status, and may throw std::bad_alloc on a hostile header
     // (its own counts decide its allocations): both end here as a reason.
     try {
@@ -27,30 +28,34 @@ bool decodeDraco(const unsigned char *data, size_t size, int positionId, DracoMe
             *err = "libdraco decoded no mesh";
             return false;
         }
-        const draco::PointAttribute *att = positionId >= 0 ? mesh->GetAttributeByUniqueId(uint32_t(positionId)) : nullptr;
-        if (!att) {
-            *err = "the Draco data has no attribute with the id " + std::to_string(positionId) +
-                   " that the extension's attributes.POSITION names";
-            return false;
-        }
-        if (att->num_components() != 3) {
-            *err = "the Draco POSITION attribute has " + std::to_string(int(att->num_components())) +
-                   " components; POSITION needs 3";
-            return false;
-        }
-        const draco::DataType t = att->data_type();
-        out->integerPositions = t != draco::DT_FLOAT32 && t != draco::DT_FLOAT64;
-        const size_t points = mesh->num_points(), faces = mesh->num_faces();
-        out->positions.assign(points * 3, 0.0);
-        for (draco::PointIndex i(0); i < mesh->num_points(); ++i) {
-            double v[3];
-            if (!att->ConvertValue<double>(att->mapped_index(i), 3, v)) {
-                *err = "libdraco cannot convert point " + std::to_string(i.value()) + "'s position";
+        out->points = mesh->num_points();
+        for (const auto &[name, idComps] : ids) {
+            const auto [id, comps] = idComps;
+            const draco::PointAttribute *att = id >= 0 ? mesh->GetAttributeByUniqueId(uint32_t(id)) : nullptr;
+            if (!att) {
+                *err = "the Draco data has no attribute with the id " + std::to_string(id) + " that the extension's attributes." +
+                       name + " names";
                 return false;
             }
-            std::copy(v, v + 3, out->positions.begin() + std::ptrdiff_t(size_t(i.value()) * 3));
+            if (att->num_components() != comps) {
+                *err = "the Draco " + name + " attribute has " + std::to_string(int(att->num_components())) +
+                       " components; " + name + " needs " + std::to_string(comps);
+                return false;
+            }
+            DracoAttribute &a = out->attributes[name];
+            a.components = comps;
+            a.integer = att->data_type() != draco::DT_FLOAT32 && att->data_type() != draco::DT_FLOAT64;
+            a.values.assign(out->points * size_t(comps), 0.0);
+            double v[4];
+            for (draco::PointIndex i(0); i < mesh->num_points(); ++i) {
+                if (!att->ConvertValue<double>(att->mapped_index(i), int8_t(comps), v)) {
+                    *err = "libdraco cannot convert point " + std::to_string(i.value()) + "'s " + name;
+                    return false;
+                }
+                std::copy(v, v + comps, a.values.begin() + std::ptrdiff_t(size_t(i.value()) * size_t(comps)));
+            }
         }
-        out->indices.resize(faces * 3);
+        out->indices.resize(size_t(mesh->num_faces()) * 3);
         for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f) {
             const draco::Mesh::Face &face = mesh->face(f);
             for (int c = 0; c < 3; ++c) out->indices[size_t(f.value()) * 3 + size_t(c)] = face[c].value();

@@ -5,25 +5,32 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace va::gltf {
 
-// A KHR_draco_mesh_compression primitive, decoded: the POSITION attribute's values as the codec
-// holds them (3 per point, dequantized by libdraco when the encoder quantized them; raw integers
-// when the attribute is integer) and the faces' point indices (3 per face).
+// A KHR_draco_mesh_compression primitive, decoded: the attributes asked for, by glTF name (POSITION,
+// JOINTS_0, ...), each as its values in the codec (dequantized by libdraco when the encoder quantized
+// them; raw integers when the attribute is an integer type), and the faces' point indices (3 per face).
+struct DracoAttribute {
+    int components = 0;
+    bool integer = false;        // an integer type (the accessor says whether it is normalized)
+    std::vector<double> values;  // components per point
+};
 struct DracoMesh {
-    std::vector<double> positions;
+    size_t points = 0;
+    std::map<std::string, DracoAttribute> attributes;
     std::vector<uint32_t> indices;
-    bool integerPositions = false;  // the attribute is an integer type (the accessor says whether
-                                    //   it is normalized)
 };
 
-// Decodes `size` bytes of Draco mesh data and takes the attribute whose unique id is `positionId`
-// (the extension's attributes.POSITION). False with a reason (no file name) when libdraco refuses the
-// data, it is a point cloud, the attribute is missing or is not 3-component.
-bool decodeDraco(const unsigned char *data, size_t size, int positionId, DracoMesh *out, std::string *err);
+// Decodes `size` bytes of Draco mesh data and takes the attributes `ids` names (glTF name -> the
+// unique id the extension's `attributes` gives it). False with a reason (no file name) when libdraco
+// refuses the data, it is a point cloud, or an attribute is missing or has other than `components`.
+bool decodeDraco(const unsigned char *data, size_t size, const std::map<std::string, std::pair<int, int>> &ids,
+                 DracoMesh *out, std::string *err);
 
 // EXT_meshopt_compression's bufferView extension (the decoded bytes are the buffer view's data).
 enum class MeshoptMode { Attributes, Triangles, Indices };

@@ -24,6 +24,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "analysis/gltf_decode.h"
@@ -130,6 +131,17 @@ struct PrimitiveGeometry {
     std::vector<Vec3> positions;
     std::vector<uint32_t> order;  // vertex indices in primitive order (every one < positions.size())
     int mode = TINYGLTF_MODE_TRIANGLES;  // triangles, strip or fan
+    // A skinned node's primitive: its JOINTS_n and WEIGHTS_n sets, 4 values per vertex each.
+    std::vector<std::vector<double>> joints, weights;
+};
+
+// A skinned node's primitive, placed after the walk (its joints may come later in node order) into
+// the object reserved for it at its place in the walk.
+struct SkinnedPrimitive {
+    size_t object;
+    int node, skin;
+    std::shared_ptr<const PrimitiveGeometry> geometry;
+    std::string where;
 };
 
 // What a node puts in the scene: its world transform, one per EXT_mesh_gpu_instancing instance.
@@ -152,6 +164,10 @@ struct GltfLoader {
     uint64_t triangles = 0;               // of the primitives added so far
     std::map<int, std::vector<unsigned char>> meshoptViews;  // decoded EXT_meshopt_compression views
     std::map<int, gltf::DracoMesh> dracoViews;               // decoded KHR_draco_mesh_compression views
+    std::vector<SkinnedPrimitive> skinnedPrimitives;          // placed after the walk (applySkins)
+    std::set<int> jointNodes;                                 // every skin's joints
+    std::map<int, Mat4> jointWorlds;                          // their world transforms, from the walk
+    std::vector<int> parents;                                 // for joints outside the walk (worldOf)
 
     // Accessor elements a primitive may need within the triangle limit: 3 per triangle (a strip or
     // fan needs fewer).
@@ -405,7 +421,8 @@ struct GltfLoader {
         return mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;
     }
 
-    // A KHR_draco_mesh_compression primitive's positions and faces (decoded once per buffer view).
+    // A KHR_draco_mesh_compression primitive's positions, skin attributes and faces (decoded once per
+    // buffer view).
     bool readDraco(const tinygltf::Primitive &prim, const Value &ext, int meshIdx, size_t primIdx, int posAccessor,
                    PrimitiveGeometry *g, std::string *e) {
         int64_t bv = -1, posId = -1;
@@ -416,6 +433,15 @@ struct GltfLoader {
             return false;
         }
         if (bv < 0 || bv > INT32_MAX) bv = -1;
+        // What to take from the Draco data: POSITION, and the skin's JOINTS_n / WEIGHTS_n it holds.
+        const Value &attrs = ext.Get("attributes");
+        std::map<std::string, std::pair<int, int>> ids;
+        ids["POSITION"] = {int(std::clamp<int64_t>(posId, -1, INT32_MAX)), 3};
+        for (const std::string &name : attrs.Keys()) {
+            int64_t id = -1;
+            if ((name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0) && intMember(attrs, name.c_str(), &id))
+                ids[name] = {int(std::clamp<int64_t>(id, -1, INT32_MAX)), 4};
+        }
         auto cached = dracoViews.find(int(bv));
         if (cached == dracoViews.end()) {
             const unsigned char *data = nullptr;
@@ -428,7 +454,7 @@ struct GltfLoader {
             }
             gltf::DracoMesh dm;
             std::string de;
-            if (!gltf::decodeDraco(data, size, int(std::clamp<int64_t>(posId, -1, INT32_MAX)), &dm, &de)) {
+            if (!gltf::decodeDraco(data, size, ids, &dm, &de)) {
                 *e = "KHR_draco_mesh_compression (buffer view " + std::to_string(bv) + "): " + de;
                 return false;
             }
@@ -438,7 +464,7 @@ struct GltfLoader {
         // The accessors describe the decoded data (KHR_draco_mesh_compression, "Conformance"): their
         // counts must be what libdraco decoded.
         const auto &pa = model.accessors[size_t(posAccessor)];
-        const size_t points = dm.positions.size() / 3, corners = dm.indices.size();
+        const size_t points = dm.points, corners = dm.indices.size();
         if (pa.count != points) {
             *e = "KHR_draco_mesh_compression decoded " + std::to_string(points) + " points, but POSITION accessor " +
                  std::to_string(posAccessor) + " declares " + std::to_string(pa.count) + "; the file is inconsistent";
@@ -453,16 +479,27 @@ struct GltfLoader {
                  " indices; the file is inconsistent";
             return false;
         }
-        (void)prim;
-        const bool normalize = dm.integerPositions && pa.normalized;
+        // An attribute's values as its accessor reads them: normalized integers mapped as componentValue.
+        auto values = [&](const std::string &name, int accessor, std::vector<double> *out) {
+            const gltf::DracoAttribute &da = dm.attributes.at(name);
+            *out = da.values;
+            const tinygltf::Accessor *acc =
+                accessor >= 0 && size_t(accessor) < model.accessors.size() ? &model.accessors[size_t(accessor)] : nullptr;
+            if (da.integer && acc && acc->normalized)
+                for (double &v : *out) v = normalizedValue(acc->componentType, v);
+        };
+        std::vector<double> p;
+        values("POSITION", posAccessor, &p);
         g->positions.resize(points);
-        for (size_t i = 0; i < points; ++i) {
-            double v[3];
-            for (int c = 0; c < 3; ++c) {
-                v[c] = dm.positions[3 * i + size_t(c)];
-                if (normalize) v[c] = normalizedValue(pa.componentType, v[c]);
-            }
-            g->positions[i] = {v[0], v[1], v[2]};
+        for (size_t i = 0; i < points; ++i) g->positions[i] = {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+        for (int set = 0;; ++set) {
+            const std::string j = "JOINTS_" + std::to_string(set), w = "WEIGHTS_" + std::to_string(set);
+            if (!dm.attributes.count(j) || !dm.attributes.count(w)) break;
+            g->joints.emplace_back();
+            g->weights.emplace_back();
+            auto ja = prim.attributes.find(j), wa = prim.attributes.find(w);
+            values(j, ja == prim.attributes.end() ? -1 : ja->second, &g->joints.back());
+            values(w, wa == prim.attributes.end() ? -1 : wa->second, &g->weights.back());
         }
         g->order = dm.indices;
         g->mode = TINYGLTF_MODE_TRIANGLES;  // Draco holds faces, whatever the primitive's mode
@@ -471,7 +508,8 @@ struct GltfLoader {
 
     // Reads one primitive's geometry in mesh space. Out-of-range indices are refused (the file is
     // damaged), as OBJ and PLY indices are, naming the first one.
-    bool readPrimitive(int meshIdx, size_t primIdx, int mode, const std::string &where, PrimitiveGeometry *g) {
+    bool readPrimitive(int meshIdx, size_t primIdx, int mode, bool skinned, const std::string &where,
+                       PrimitiveGeometry *g) {
         const auto &prim = model.meshes[size_t(meshIdx)].primitives[primIdx];
         auto pos = prim.attributes.find("POSITION");
         if (pos == prim.attributes.end()) {
@@ -517,8 +555,30 @@ struct GltfLoader {
                 g->order.resize(g->positions.size());
                 for (size_t i = 0; i < g->order.size(); ++i) g->order[i] = uint32_t(i);
             }
+            // A skinned node's joints and weights: JOINTS_0 / WEIGHTS_0, then _1, ... while both exist.
+            for (int set = 0; skinned; ++set) {
+                auto ja = prim.attributes.find("JOINTS_" + std::to_string(set));
+                auto wa = prim.attributes.find("WEIGHTS_" + std::to_string(set));
+                if (ja == prim.attributes.end() || wa == prim.attributes.end()) break;
+                g->joints.emplace_back();
+                g->weights.emplace_back();
+                if (!readAccessor(ja->second, 4, &g->joints.back(), &e)) {
+                    err = where + "JOINTS_" + std::to_string(set) + " " + e;
+                    return false;
+                }
+                if (!readAccessor(wa->second, 4, &g->weights.back(), &e)) {
+                    err = where + "WEIGHTS_" + std::to_string(set) + " " + e;
+                    return false;
+                }
+            }
         }
         const size_t nv = g->positions.size();
+        for (size_t set = 0; set < g->joints.size(); ++set)
+            if (g->joints[set].size() != 4 * nv || g->weights[set].size() != 4 * nv) {
+                err = where + "JOINTS_" + std::to_string(set) + " or WEIGHTS_" + std::to_string(set) +
+                      " does not have one element per vertex (" + std::to_string(nv) + "); the file is inconsistent";
+                return false;
+            }
         if (nv > std::numeric_limits<uint32_t>::max()) {
             err = where + "more than 2^32 - 1 vertices";
             return false;
@@ -537,33 +597,28 @@ struct GltfLoader {
         return true;
     }
 
-    // Appends a primitive's triangles, placed by `world`, as a source object.
-    void emit(const PrimitiveGeometry &g, const Mat4 &world, const std::string &name, uint32_t material,
-              const std::string &where) {
-        SceneBuildInput::Object o;
-        o.name = name;
-        o.mesh = path;
-        o.material = material;
-        RawMesh &m = o.geometry;
-        m.positions.resize(g.positions.size());
-        for (size_t i = 0; i < g.positions.size(); ++i) m.positions[i] = transformPoint(world, g.positions[i]);
-        // A mirroring world transform (negative determinant) turns counter-clockwise into clockwise:
-        // swap two corners so the front face stays counter-clockwise (glTF 2.0, "Transformations").
-        const bool flip = det3(world) < 0;
+    // Fills `m` with a primitive's triangles over `positions` (world space, one per vertex). A
+    // mirroring transform (negative determinant) turns counter-clockwise into clockwise: where
+    // `mirrored` says so at a triangle's first corner, two corners are swapped so the front face stays
+    // counter-clockwise (glTF 2.0, "Transformations").
+    void fillTriangles(const PrimitiveGeometry &g, std::vector<Vec3> positions, const std::vector<char> &mirrored,
+                       const std::string &where, RawMesh *m) {
+        m->positions = std::move(positions);
         const auto &order = g.order;
         auto addTri = [&](uint32_t a, uint32_t b, uint32_t c) {
-            ++m.facesRead;
-            m.indices.push_back(a);
-            m.indices.push_back(flip ? c : b);
-            m.indices.push_back(flip ? b : c);
+            const bool flip = mirrored[a];
+            ++m->facesRead;
+            m->indices.push_back(a);
+            m->indices.push_back(flip ? c : b);
+            m->indices.push_back(flip ? b : c);
         };
         // Triangle lists, strips and fans as glTF 2.0 defines their triangles.
         if (g.mode == TINYGLTF_MODE_TRIANGLES) {
-            m.indices.reserve(order.size() / 3 * 3);
+            m->indices.reserve(order.size() / 3 * 3);
             for (size_t i = 0; i + 2 < order.size(); i += 3) addTri(order[i], order[i + 1], order[i + 2]);
             if (order.size() % 3 != 0) {
-                ++m.facesDropped;
-                m.warnings.push_back(where + std::to_string(order.size() % 3) + " trailing index(es) ignored");
+                ++m->facesDropped;
+                m->warnings.push_back(where + std::to_string(order.size() % 3) + " trailing index(es) ignored");
             }
         } else if (g.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
             for (size_t i = 0; i + 2 < order.size(); ++i)
@@ -571,6 +626,18 @@ struct GltfLoader {
         } else {
             for (size_t i = 1; i + 1 < order.size(); ++i) addTri(order[i], order[i + 1], order[0]);
         }
+    }
+
+    // Appends a primitive's triangles, placed by `world`, as a source object.
+    void emit(const PrimitiveGeometry &g, const Mat4 &world, const std::string &name, uint32_t material,
+              const std::string &where) {
+        SceneBuildInput::Object o;
+        o.name = name;
+        o.mesh = path;
+        o.material = material;
+        std::vector<Vec3> positions(g.positions.size());
+        for (size_t i = 0; i < g.positions.size(); ++i) positions[i] = transformPoint(world, g.positions[i]);
+        fillTriangles(g, std::move(positions), std::vector<char>(g.positions.size(), det3(world) < 0), where, &o.geometry);
         out->objects.push_back(std::move(o));
     }
 
@@ -639,6 +706,17 @@ struct GltfLoader {
             err = path + ": node '" + nodeName(nodeIdx) + "' refers to mesh " + std::to_string(n.mesh) + ", which does not exist";
             return false;
         }
+        const bool skinned = n.skin >= 0;
+        if (skinned && (size_t(n.skin) >= model.skins.size())) {
+            err = path + ": node '" + nodeName(nodeIdx) + "' refers to skin " + std::to_string(n.skin) + ", which does not exist";
+            return false;
+        }
+        if (skinned && extension(n.extensions, "EXT_mesh_gpu_instancing")) {
+            err = path + ": node '" + nodeName(nodeIdx) +
+                  "' has both a skin and EXT_mesh_gpu_instancing, which visaudit does not combine; export the "
+                  "instances as nodes of their own";
+            return false;
+        }
         std::vector<Placement> pl;
         if (!placements(nodeIdx, world, &pl)) return false;
         const auto &mesh = model.meshes[size_t(n.mesh)];
@@ -666,7 +744,7 @@ struct GltfLoader {
             if (!checkTriangleLimit(triangles, maxTriangles, where + "the scene up to this primitive", &err))
                 return false;
             PrimitiveGeometry g;
-            if (!readPrimitive(n.mesh, p, mode, where, &g)) return false;
+            if (!readPrimitive(n.mesh, p, mode, skinned, where, &g)) return false;
             // Draco data without an index accessor declares no triangle count: count what it decoded.
             const uint64_t decoded = g.mode == TINYGLTF_MODE_TRIANGLES ? g.order.size() / 3
                                      : g.order.size() >= 3 ? g.order.size() - 2 : 0;
@@ -678,8 +756,137 @@ struct GltfLoader {
             }
             const uint32_t material =
                 prim.material >= 0 && size_t(prim.material) < materialIndex.size() ? materialIndex[size_t(prim.material)] : 0;
+            if (skinned) {
+                // Its object now, at its place in the walk; its triangles once every joint is placed.
+                SceneBuildInput::Object o;
+                o.name = mesh.primitives.size() > 1 ? pl[0].name + "/" + std::to_string(p) : pl[0].name;
+                o.mesh = path;
+                o.material = material;
+                skinnedPrimitives.push_back({out->objects.size(), nodeIdx, n.skin,
+                                             std::make_shared<const PrimitiveGeometry>(std::move(g)), where});
+                out->objects.push_back(std::move(o));
+                continue;
+            }
             for (const Placement &at : pl)
                 emit(g, at.world, mesh.primitives.size() > 1 ? at.name + "/" + std::to_string(p) : at.name, material, where);
+        }
+        return true;
+    }
+
+    // A node's world transform outside the walk (a joint not in the loaded scene): its ancestors'
+    // local transforms up to a root, climbed without recursion.
+    bool worldOf(int nodeIdx, Mat4 *world) {
+        if (parents.empty()) {
+            parents.assign(model.nodes.size(), -1);
+            for (size_t i = 0; i < model.nodes.size(); ++i)
+                for (int c : model.nodes[i].children)
+                    if (c >= 0 && size_t(c) < parents.size() && parents[size_t(c)] < 0) parents[size_t(c)] = int(i);
+        }
+        Mat4 w = Mat4::identity();
+        size_t steps = 0;
+        for (int i = nodeIdx; i >= 0; i = parents[size_t(i)]) {
+            if (++steps > model.nodes.size()) {
+                err = path + ": node '" + nodeName(nodeIdx) + "' has a cycle among its ancestors";
+                return false;
+            }
+            w = nodeLocalMatrix(model.nodes[size_t(i)]) * w;
+        }
+        *world = w;
+        return true;
+    }
+
+    // Skinning at rest (glTF 2.0, "Skins"): a vertex is at sum_k w_k J_k B_k v, J_k the world transform
+    // of its k-th joint, B_k that joint's inverse bind matrix; the node's own transform is not used.
+    // Weights are divided by their sum (glTF requires it to be 1; three.js divides too). A vertex whose
+    // weights are all zero (an invalid file) follows its first joint (JOINTS_0's first) with weight 1,
+    // as three.js does, and a warning counts such vertices. (Blender's exporter writes skinned vertices
+    // in world space with J B = identity, so the node's transform would place them twice: the castle
+    // dungeon's switch, whose base has no weights, was drawn a third of its size 7 units away.)
+    bool applySkins() {
+        std::map<int, std::vector<Mat4>> skinMatrices;  // skin -> J_k B_k
+        for (const SkinnedPrimitive &sp : skinnedPrimitives) {
+            const auto &skin = model.skins[size_t(sp.skin)];
+            const std::string sw = sp.where + "skin " + std::to_string(sp.skin) + ": ";
+            auto sm = skinMatrices.find(sp.skin);
+            if (sm == skinMatrices.end()) {
+                std::vector<double> ibm;
+                std::string e;
+                if (skin.inverseBindMatrices >= 0 && !readAccessor(skin.inverseBindMatrices, 16, &ibm, &e)) {
+                    err = sw + "inverseBindMatrices " + e;
+                    return false;
+                }
+                if (skin.inverseBindMatrices >= 0 && ibm.size() < 16 * skin.joints.size()) {
+                    err = sw + "inverseBindMatrices has " + std::to_string(ibm.size() / 16) + " matrices for " +
+                          std::to_string(skin.joints.size()) + " joints; the file is inconsistent";
+                    return false;
+                }
+                std::vector<Mat4> m(skin.joints.size());
+                for (size_t k = 0; k < skin.joints.size(); ++k) {
+                    const int j = skin.joints[k];
+                    if (j < 0 || size_t(j) >= model.nodes.size()) {
+                        err = sw + "joint " + std::to_string(k) + " is node " + std::to_string(j) + ", which does not exist";
+                        return false;
+                    }
+                    Mat4 jw;
+                    auto walked = jointWorlds.find(j);
+                    if (walked != jointWorlds.end()) jw = walked->second;
+                    else if (!worldOf(j, &jw)) return false;
+                    Mat4 b;  // column-major in the file
+                    if (!ibm.empty())
+                        for (int c = 0; c < 4; ++c)
+                            for (int r = 0; r < 4; ++r) b.m[r][c] = ibm[16 * k + size_t(c * 4 + r)];
+                    m[k] = jw * b;
+                }
+                sm = skinMatrices.emplace(sp.skin, std::move(m)).first;
+            }
+            const std::vector<Mat4> &jm = sm->second;
+            const PrimitiveGeometry &g = *sp.geometry;
+            const size_t nv = g.positions.size();
+            std::vector<Vec3> positions(nv);
+            std::vector<char> mirrored(nv);
+            uint64_t unweighted = 0;
+            for (size_t v = 0; v < nv; ++v) {
+                Mat4 sum;
+                for (auto &row : sum.m)
+                    for (double &x : row) x = 0;
+                double total = 0;
+                for (size_t set = 0; set < g.joints.size(); ++set)
+                    for (size_t c = 0; c < 4; ++c) {
+                        const double w = g.weights[set][4 * v + c], j = g.joints[set][4 * v + c];
+                        if (w == 0) continue;
+                        if (!(j >= 0 && j < double(jm.size()) && std::floor(j) == j)) {
+                            const bool integral = std::floor(j) == j && std::fabs(j) < 9.0e15;
+                            err = sw + "JOINTS_" + std::to_string(set) + " of vertex " + std::to_string(v) + " is " +
+                                  (integral ? std::to_string(int64_t(j)) : std::to_string(j)) +
+                                  ", not one of the skin's " + std::to_string(jm.size()) +
+                                  " joints; the file is damaged";
+                            return false;
+                        }
+                        total += w;
+                        for (int r = 0; r < 4; ++r)
+                            for (int k = 0; k < 4; ++k) sum.m[r][k] += w * jm[size_t(j)].m[r][k];
+                    }
+                if (total > 0 && std::isfinite(total)) {
+                    for (auto &row : sum.m)
+                        for (double &x : row) x /= total;
+                } else {
+                    const double j = g.joints.empty() ? 0 : g.joints[0][4 * v];
+                    if (!(j >= 0 && j < double(jm.size()) && std::floor(j) == j)) {
+                        err = sw + "vertex " + std::to_string(v) + " has no joint weight and no valid first joint; "
+                                   "the file is damaged";
+                        return false;
+                    }
+                    sum = jm[size_t(j)];
+                    ++unweighted;
+                }
+                positions[v] = transformPoint(sum, g.positions[v]);
+                mirrored[v] = det3(sum) < 0;
+            }
+            if (unweighted > 0)
+                out->warnings.push_back(sw + std::to_string(unweighted) + " of " + std::to_string(nv) +
+                                        " vertices have no joint weight (glTF requires weights summing to 1): each "
+                                        "follows its first joint, as three.js does");
+            fillTriangles(g, std::move(positions), mirrored, sp.where, &out->objects[sp.object].geometry);
         }
         return true;
     }
@@ -805,6 +1012,7 @@ struct GltfLoader {
             entered[size_t(nodeIdx)] = onPath[size_t(nodeIdx)] = 1;
             const auto &n = model.nodes[size_t(nodeIdx)];
             const Mat4 world = parentWorld * nodeLocalMatrix(n);
+            if (jointNodes.count(nodeIdx)) jointWorlds[nodeIdx] = world;
             if (n.mesh >= 0 && !addMesh(nodeIdx, world)) return false;
             if (n.camera >= 0 && !addCamera(nodeIdx, world)) return false;
             if (!addLight(nodeIdx, world)) return false;
@@ -873,7 +1081,9 @@ struct GltfLoader {
             for (size_t i = 0; i < model.nodes.size(); ++i)
                 if (!isChild[i]) roots.push_back(int(i));
         }
+        for (const auto &skin : model.skins) jointNodes.insert(skin.joints.begin(), skin.joints.end());
         if (!walk(roots)) return false;
+        if (!applySkins()) return false;
         if (skippedPrimitives)
             out->warnings.push_back(path + ": " + std::to_string(skippedPrimitives) +
                                     " point/line primitive(s) skipped (they have no area)");
@@ -936,7 +1146,7 @@ bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err, u
     in.up = 'y';  // glTF is y-up
     for (auto &w : source.warnings) in.warnings.push_back(std::move(w));
     if (!gwarn.empty()) in.warnings.push_back(path + ": tinygltf: " + oneLine(gwarn));
-    GltfLoader loader{path, model, source, &in, maxTriangles, {}, {}, {}, 0, 0, 0, {}, {}};
+    GltfLoader loader{path, model, source, &in, maxTriangles, {}, {}, {}, 0, 0, 0, {}, {}, {}, {}, {}, {}};
     if (!loader.run()) return fail(loader.err);
     *out = std::move(in);
     return true;
