@@ -658,7 +658,7 @@ bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std:
         in.objects.push_back(std::move(o));
         in.path = path;
     } else if (ext == ".gltf" || ext == ".glb") {
-        if (!loadGltf(path, &in, err, opt.maxTriangles)) return false;
+        if (!loadGltf(path, &in, err, opt.maxTriangles, opt.maxJsonDepth)) return false;
     } else {
         *err = path + ": unsupported input '" + ext +
                "'; supported: .json (visaudit-scene/1), .obj .ply .off .stl (one mesh), .gltf .glb (glTF 2.0)";

@@ -53,6 +53,7 @@ struct Options {
     // Resource limits (docs/limits.md)
     int maxResolution = kDefaultMaxResolution;
     uint64_t maxTriangles = kDefaultMaxTriangles;
+    uint64_t maxJsonDepth = kDefaultMaxJsonDepth;
     int maxRecursion = kDefaultMaxRecursion;
     uint32_t maxABufferList = kDefaultMaxABufferList;
     std::string maxMemory;  // empty: defaultMaxMemory()
@@ -142,6 +143,7 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
         lo.chunks.maxTriangles = o.chunk;
         lo.bsp.patchLevel = o.patchLevel;
         lo.maxTriangles = o.maxTriangles;
+        lo.maxJsonDepth = o.maxJsonDepth;
         if (!loadScene(o.scene, lo, scene, &err)) {
             fail(err);
             return false;
@@ -874,6 +876,12 @@ void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("--max-triangles", o.maxTriangles,
                   "Largest scene accepted, in triangles (default 100000000; at most 4294967295, the 32-bit ids)")
         ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
+    // At most 2048 (branch i16a's json::kMaxJsonDepthCeiling): tinygltf converts a glTF's extras and
+    // extensions recursively, about 0.5 KiB of stack per level in Release (it overflowed the 8 MiB
+    // stack between 15000 and 20000 levels), several times that under the sanitizers.
+    c->add_option("--max-json-depth", o.maxJsonDepth,
+                  "Deepest nesting of arrays and objects accepted in a JSON input (default 512, at most 2048)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(2048)));
 }
 
 void addAnalyzeOptions(CLI::App *c, Options &o) {

@@ -4,6 +4,7 @@
 #   data/cgal/elephant.off, data/cgal/armadillo.off (libcgal-demo: data.tar.gz)
 #   data/openarena/pak6-patch088.pk3 (openarena-088-data: maps/oa_thor.bsp, ...)
 #   data/openarena/pak1-maps.pk3     (openarena-081-maps: maps/q3dm6ish.bsp, maps/oa_dm1.bsp, ...)
+#   data/castle/variants/            (Draco, meshopt, quantized copies of the dungeon: make-gltf-variants.sh)
 # Debian packages are fetched with `apt-get download` into a cache folder (no root needed to
 # download; `apt-get update` runs only when a download fails and we are root) and unpacked with
 # `dpkg -x`/`dpkg-deb --fsys-tarfile`, taking only the files we need. Idempotent: files already in
@@ -84,5 +85,9 @@ for pair in openarena-088-data:pak6-patch088.pk3 openarena-081-maps:pak1-maps.pk
   echo "fetch-data: fetched $OA_OUT/$pk3 from $(basename "$deb")"
 done
 
+# 4. Draco, meshopt and quantized variants of the dungeon, made by real optimizers from the npm
+#    registry (gltfpack, gltf-transform) at pinned versions: scripts/make-gltf-variants.sh.
+bash "$ROOT/scripts/make-gltf-variants.sh"
+
 echo "fetch-data: data in $DATA:"
-(cd "$DATA" && find . -type f \( -name '*.gltf' -o -name '*.bin' -o -name '*.off' -o -name '*.pk3' \) -printf '  %p (%s bytes)\n' | sort)
+(cd "$DATA" && find . -type f \( -name '*.gltf' -o -name '*.glb' -o -name '*.bin' -o -name '*.off' -o -name '*.pk3' \) -printf '  %p (%s bytes)\n' | sort)

@@ -58,11 +58,17 @@ cp "$root"/examples/*.views.json "$root"/tests/browser/*.views.json "$seeds/smal
 cp "$root"/examples/*.budget.json "$seeds/small/budget_json/"
 for e in obj ply off stl; do cp "$root"/examples/meshes/*."$e" "$root"/tests/data/*."$e" "$seeds/small/$e/"; done
 cp "$root"/tests/data/*.gltf "$seeds/small/gltf/"
+# Issue 16: a glTF whose extras nest past --max-json-depth (refused before tinygltf parses it).
+python3 -c 'import sys; n = 600; sys.stdout.write("{\"asset\":{\"version\":\"2.0\"},\"extras\":" + "[" * n + "]" * n + "}")' \
+  > "$seeds/small/gltf/deep-extras.gltf"
 cp "$root"/tests/data/fuzz/* "$seeds/small/" 2>/dev/null || true
 if [ -f data/castle/level/level-dungeon.gltf ]; then
   cp data/castle/level/level-dungeon.gltf "$seeds/data/gltf/"
   python3 "$root/fuzz/make_seeds.py" "$seeds/data" data/castle/level/level-dungeon.gltf
 fi
+# The dungeon's Draco, meshopt and quantized GLBs (scripts/make-gltf-variants.sh): libdraco's and
+# libmeshoptimizer's inputs, for the long runs.
+cp data/castle/variants/*.glb "$seeds/data/glb/" 2>/dev/null || true
 [ -f data/cgal/elephant.off ] && cp data/cgal/elephant.off "$seeds/data/off/"
 if [ -f data/openarena/pak1-maps.pk3 ]; then
   # The smallest real maps (0.7-0.8 MB) and a small archive of one of them.
