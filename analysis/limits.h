@@ -15,6 +15,8 @@ constexpr int kDefaultMaxResolution = 16384;              // per side: the large
 constexpr uint64_t kDefaultMaxTriangles = 100'000'000;    // about 6.4 GB of scene model, 15 GB with Embree
 constexpr int kDefaultMaxRecursion = 16;                  // 2^17 - 2 secondary rays per pixel at worst
 constexpr uint32_t kDefaultMaxABufferList = kABufferDefaultMaxList;
+constexpr uint64_t kDefaultMaxJsonDepth = 512;            // nested arrays/objects in a JSON input (PHP's
+                                                          //   json_decode default; glTF and scenes use < 20)
 
 struct Limits {
     int maxResolution = kDefaultMaxResolution;  // width and height of a view, each: --max-resolution

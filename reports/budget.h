@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/limits.h"
+
 namespace va {
 
 constexpr const char *kBudgetFormat = "visaudit-budget/1";
@@ -31,7 +33,8 @@ struct Budget {
 
 // Reads and validates a budget file: format "visaudit-budget/1", known metric names, limit types,
 // view names that exist in `viewNames`, depth format names. Messages: FILE:LINE:COL: place: what; fix.
-bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err);
+bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err,
+                uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 
 // One budget applied to one view.
 struct BudgetCheck {
