@@ -169,43 +169,6 @@ bool moveOutOfTinygltfsWay(Json &root, Source *out) {
     return changed;
 }
 
-// The JSON nesting check every JSON input shares (issue 16). Branch i16a adds it to json_util as
-// json::checkDepth(text, file, maxDepth, err) with kMaxJsonDepthCeiling; this is the same function
-// and message, to be replaced by a call to it when both branches are merged.
-constexpr uint64_t kMaxJsonDepthCeiling = 2048;
-bool checkDepth(std::string_view text, const std::string &file, uint64_t maxDepth, std::string *err) {
-    // One pass, a counter instead of a stack: '[' and '{' open a level, ']' and '}' close one, and
-    // a string (from '"' to the next '"' not escaped by '\\') is skipped whole.
-    uint64_t depth = 0, deepest = 0;
-    size_t firstOver = std::string_view::npos;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (c == '"') {
-            for (++i; i < text.size() && text[i] != '"'; ++i)
-                if (text[i] == '\\') ++i;
-        } else if (c == '[' || c == '{') {
-            if (++depth > deepest) deepest = depth;
-            if (depth > maxDepth && firstOver == std::string_view::npos) firstOver = i;
-        } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
-        }
-    }
-    if (firstOver == std::string_view::npos) return true;
-    size_t line = 1, lineStart = 0;
-    for (size_t i = 0; i < firstOver; ++i)
-        if (text[i] == '\n') ++line, lineStart = i + 1;
-    const size_t col = firstOver - lineStart + 1;
-    *err = file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": arrays and objects nested " +
-           std::to_string(deepest) + " levels deep, more than the limit of " + std::to_string(maxDepth) + "; ";
-    if (deepest <= kMaxJsonDepthCeiling)
-        *err += "raise it with --max-json-depth " + std::to_string(deepest) + " if the file is meant to nest so deep";
-    else
-        *err += "--max-json-depth accepts at most " + std::to_string(kMaxJsonDepthCeiling) +
-                " (no scene, views, glTF, budget or report file nests so deep): the file is damaged or was "
-                "made to exhaust a parser's stack";
-    return false;
-}
-
 }  // namespace
 
 bool prepareSource(const std::string &path, bool binary, uint64_t maxJsonDepth, Source *out, std::string *err) {
@@ -250,7 +213,7 @@ bool prepareSource(const std::string &path, bool binary, uint64_t maxJsonDepth, 
     const char *text = reinterpret_cast<const char *>(b) + jsonBegin;
 
     // Nesting before parsing: tinygltf converts extras and extensions recursively.
-    if (!checkDepth(std::string_view(text, jsonSize), binary ? path + " (JSON chunk)" : path, maxJsonDepth, err))
+    if (!json::checkDepth(std::string_view(text, jsonSize), binary ? path + " (JSON chunk)" : path, maxJsonDepth, err))
         return false;
 
     Json root = Json::parse(text, text + jsonSize, nullptr, /*allow_exceptions=*/false);

@@ -18,7 +18,7 @@ std::string pathString(const Path &p) {
     return s;
 }
 
-void lineCol(const std::string &text, size_t offset, size_t *line, size_t *col) {
+void lineCol(std::string_view text, size_t offset, size_t *line, size_t *col) {
     offset = std::min(offset, text.size());
     size_t l = 1, lineStart = 0;
     for (size_t i = 0; i < offset; ++i)
@@ -27,7 +27,38 @@ void lineCol(const std::string &text, size_t offset, size_t *line, size_t *col) 
     *col = offset - lineStart + 1;
 }
 
-bool parseFile(const std::string &file, Doc *doc, std::string *err) {
+bool checkDepth(std::string_view text, const std::string &file, uint64_t maxDepth, std::string *err) {
+    // One pass, a counter instead of a stack: '[' and '{' open a level, ']' and '}' close one, and
+    // a string (from '"' to the next '"' not escaped by '\\') is skipped whole.
+    uint64_t depth = 0, deepest = 0;
+    size_t firstOver = std::string_view::npos;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (c == '"') {
+            for (++i; i < text.size() && text[i] != '"'; ++i)
+                if (text[i] == '\\') ++i;
+        } else if (c == '[' || c == '{') {
+            if (++depth > deepest) deepest = depth;
+            if (depth > maxDepth && firstOver == std::string_view::npos) firstOver = i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    if (firstOver == std::string_view::npos) return true;
+    size_t line = 0, col = 0;
+    lineCol(text, firstOver, &line, &col);
+    *err = file + ":" + std::to_string(line) + ":" + std::to_string(col) + ": arrays and objects nested " +
+           std::to_string(deepest) + " levels deep, more than the limit of " + std::to_string(maxDepth) + "; ";
+    if (deepest <= kMaxJsonDepthCeiling)
+        *err += "raise it with --max-json-depth " + std::to_string(deepest) + " if the file is meant to nest so deep";
+    else
+        *err += "--max-json-depth accepts at most " + std::to_string(kMaxJsonDepthCeiling) +
+                " (no scene, views, glTF, budget or report file nests so deep): the file is damaged or was "
+                "made to exhaust a parser's stack";
+    return false;
+}
+
+bool parseFile(const std::string &file, Doc *doc, std::string *err, uint64_t maxDepth) {
     std::error_code ec;
     if (!std::filesystem::exists(file, ec)) {
         *err = file + ": file not found";
@@ -42,6 +73,7 @@ bool parseFile(const std::string &file, Doc *doc, std::string *err) {
     ss << f.rdbuf();
     doc->file = file;
     doc->text = std::move(ss).str();
+    if (!checkDepth(doc->text, file, maxDepth, err)) return false;
     try {
         doc->root = Json::parse(doc->text);
     } catch (const Json::parse_error &e) {
@@ -100,35 +132,25 @@ struct Scanner {
         ++i;
         return s;
     }
-    void value() {  // skips one value
+    // Skips one value. Arrays and objects are skipped by counting brackets (strings skipped whole),
+    // never by recursion: the text's depth is bounded by checkDepth, but this walk needs no bound.
+    void value() {
         ws();
         if (i >= t.size()) return;
         const char c = t[i];
         if (c == '"') {
             string();
         } else if (c == '{' || c == '[') {
-            const char close = c == '{' ? '}' : ']';
-            ++i;
-            ws();
-            if (i < t.size() && t[i] == close) {
-                ++i;
-                return;
-            }
+            size_t depth = 0;
             while (i < t.size()) {
-                ws();
-                if (c == '{') {
+                const char d = t[i];
+                if (d == '"') {
                     string();
-                    ws();
-                    ++i;  // ':'
-                }
-                value();
-                ws();
-                if (i < t.size() && t[i] == ',') {
-                    ++i;
                     continue;
                 }
-                ++i;  // close
-                return;
+                ++i;
+                if (d == '{' || d == '[') ++depth;
+                else if ((d == '}' || d == ']') && --depth == 0) return;
             }
         } else {
             while (i < t.size() && t[i] != ',' && t[i] != '}' && t[i] != ']' && t[i] != ' ' && t[i] != '\n' &&

@@ -36,9 +36,11 @@ bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err,
 
 // Reads a views file: { "views": [ ... ] } with DESIGN.md's view keys.
 // Views without "up" get the file's top-level "up" axis if it has one, else the y axis.
-bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::string *err);
+bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::string *err,
+                   uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 // The same, with views lacking "up" (and a file without "up") defaulting to the scene's up axis.
-bool loadViewsFile(const std::string &path, char sceneUp, std::vector<ViewSpec> *out, std::string *err);
+bool loadViewsFile(const std::string &path, char sceneUp, std::vector<ViewSpec> *out, std::string *err,
+                   uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 
 // N cameras around the scene's bounds looking at its center (deterministic).
 std::vector<ViewSpec> orbitViews(const Scene &scene, int n);

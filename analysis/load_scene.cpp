@@ -348,7 +348,7 @@ bool readCellsAndPortals(Reader &r, const Json &root, std::vector<Cell> *cellsOu
 
 bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
     json::Doc doc;
-    if (!json::parseFile(path, &doc, err)) return false;
+    if (!json::parseFile(path, &doc, err, opt.maxJsonDepth)) return false;
     Reader r{doc, {}};
     auto failed = [&] {
         *err = r.err;
@@ -595,9 +595,10 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
 
 }  // namespace
 
-bool loadViewsFile(const std::string &path, char sceneUp, std::vector<ViewSpec> *out, std::string *err) {
+bool loadViewsFile(const std::string &path, char sceneUp, std::vector<ViewSpec> *out, std::string *err,
+                   uint64_t maxJsonDepth) {
     json::Doc doc;
-    if (!json::parseFile(path, &doc, err)) return false;
+    if (!json::parseFile(path, &doc, err, maxJsonDepth)) return false;
     Reader r{doc, {}};
     const Path top;
     if (!doc.root.is_object()) {
@@ -626,8 +627,8 @@ bool loadViewsFile(const std::string &path, char sceneUp, std::vector<ViewSpec> 
     return true;
 }
 
-bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::string *err) {
-    return loadViewsFile(path, 'y', out, err);
+bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::string *err, uint64_t maxJsonDepth) {
+    return loadViewsFile(path, 'y', out, err, maxJsonDepth);
 }
 
 bool loadScene(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {

@@ -23,6 +23,7 @@
 
 #include "analysis/demo.h"
 #include "analysis/depth_audit.h"
+#include "analysis/json_util.h"
 #include "analysis/level_views.h"
 #include "analysis/limits.h"
 #include "analysis/load.h"
@@ -167,7 +168,7 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
             return false;
         }
         *views = orbitViews(*scene, int(k));
-    } else if (!loadViewsFile(o.views, views, &err)) {
+    } else if (!loadViewsFile(o.views, views, &err, o.maxJsonDepth)) {
         fail(err);
         return false;
     }
@@ -616,7 +617,7 @@ int cmdCheck(const Options &o) {
     std::string err;
     if (!o.baseline.empty()) {
         std::string detail;
-        const JsonRead r = readJsonDocument(o.baseline, &baseline, &detail);
+        const JsonRead r = readJsonDocument(o.baseline, &baseline, &detail, o.maxJsonDepth);
         if (r == JsonRead::unreadable) {
             fail("--baseline " + o.baseline + ": cannot be read; give the report.json of an earlier analyze run");
             return kExitBadInput;
@@ -625,12 +626,16 @@ int cmdCheck(const Options &o) {
             fail("--baseline " + o.baseline + ": not valid JSON (" + detail + ")");
             return kExitBadInput;
         }
+        if (r == JsonRead::tooDeep) {
+            fail("--baseline " + detail);
+            return kExitBadInput;
+        }
     }
     // The budget is validated against the views before anything is analysed.
     auto validate = [&](const std::vector<ViewSpec> &views, PipelineSettings *s, std::string *e) {
         std::vector<std::string> names;
         for (const ViewSpec &v : views) names.push_back(v.name);
-        if (!loadBudget(o.budget, names, &budget, e)) return false;
+        if (!loadBudget(o.budget, names, &budget, e, o.maxJsonDepth)) return false;
         // The formats its min_depth_format limits name join the z-fighting analysis (opt-in ones too).
         for (const DepthFormatSpec &f : budgetDepthFormats(budget))
             if (std::find(s->zfightSettings.formats.begin(), s->zfightSettings.formats.end(), f) ==
@@ -691,11 +696,13 @@ void addCheckOptions(CLI::App *c, Options &o) {
 }
 
 // Reads a JSON file for grade/check; false + message naming the file.
-bool readJsonFile(const std::string &what, const std::string &path, nlohmann::ordered_json *out, std::string *err) {
+bool readJsonFile(const std::string &what, const std::string &path, uint64_t maxJsonDepth,
+                  nlohmann::ordered_json *out, std::string *err) {
     std::string detail;
-    switch (readJsonDocument(path, out, &detail)) {
+    switch (readJsonDocument(path, out, &detail, maxJsonDepth)) {
     case JsonRead::unreadable: *err = what + " " + path + ": cannot be read"; return false;
     case JsonRead::invalid: *err = what + " " + path + ": not valid JSON (" + detail + ")"; return false;
+    case JsonRead::tooDeep: *err = what + " " + detail; return false;
     case JsonRead::ok: break;
     }
     return true;
@@ -705,9 +712,9 @@ int cmdGrade(const Options &o) {
     std::string err;
     nlohmann::ordered_json ref, sub;
     ToleranceRules tol;
-    if (!readJsonFile("--reference", o.reference, &ref, &err) ||
-        !readJsonFile("--submission", o.submission, &sub, &err) ||
-        (!o.tolerance.empty() && !loadTolerances(o.tolerance, &tol, &err))) {
+    if (!readJsonFile("--reference", o.reference, o.maxJsonDepth, &ref, &err) ||
+        !readJsonFile("--submission", o.submission, o.maxJsonDepth, &sub, &err) ||
+        (!o.tolerance.empty() && !loadTolerances(o.tolerance, &tol, &err, o.maxJsonDepth))) {
         fail(err);
         return kExitBadInput;
     }
@@ -724,11 +731,21 @@ int cmdGrade(const Options &o) {
     return g.failed ? kExitBudgetFailed : kExitOk;
 }
 
+// --max-json-depth: every command that reads JSON (docs/limits.md, "JSON nesting").
+void addJsonDepthOption(CLI::App *c, Options &o) {
+    c->add_option("--max-json-depth", o.maxJsonDepth,
+                  "Deepest nesting of arrays and objects accepted in a JSON input (default " +
+                      std::to_string(kDefaultMaxJsonDepth) + "; at most " + std::to_string(json::kMaxJsonDepthCeiling) +
+                      ")")
+        ->check(CLI::Range(uint64_t(1), json::kMaxJsonDepthCeiling));
+}
+
 void addGradeOptions(CLI::App *c, Options &o) {
     c->add_option("--reference", o.reference, "The reference report.json")->required();
     c->add_option("--submission", o.submission, "The student's report.json (the same keys)")->required();
     c->add_option("--tolerance", o.tolerance, "Tolerances per metric (visaudit-tolerance/1)");
     c->add_option("--out", o.gradeOut, "Write the result as JSON here");
+    addJsonDepthOption(c, o);
 }
 
 int cmdMerge(const Options &o) {
@@ -740,7 +757,7 @@ int cmdMerge(const Options &o) {
         return kExitBadInput;
     }
     nlohmann::ordered_json merged;
-    if (!mergeReports(o.mergeDirs, out.staging(), &merged, &err)) {
+    if (!mergeReports(o.mergeDirs, out.staging(), &merged, &err, o.maxJsonDepth)) {
         fail(err);
         return kExitBadInput;
     }
@@ -765,6 +782,7 @@ void addMergeOptions(CLI::App *c, Options &o) {
     c->add_option("shards", o.mergeDirs, "The --out folders of every analyze --shard K/N run")->required();
     c->add_option("--out", o.out, "Output folder for the merged report (written as a whole or not at all)");
     c->add_flag("--quiet", o.quiet, "No summary on the console");
+    addJsonDepthOption(c, o);
 }
 
 // depth-audit --scene: the per-view z-fighting analysis over a scene's views, with the formats'
@@ -863,6 +881,7 @@ void addDepthAuditOptions(CLI::App *c, Options &o) {
     c->add_option("--formats", o.formats, "Comma-separated depth formats, log24:C=X for log24 with constant C, or "
                                           "all (default: all)");
     c->add_option("--out", o.auditOut, "Folder for depth-audit.json and depth-audit.png");
+    addJsonDepthOption(c, o);
 }
 
 void addSceneOptions(CLI::App *c, Options &o) {
@@ -876,12 +895,7 @@ void addSceneOptions(CLI::App *c, Options &o) {
     c->add_option("--max-triangles", o.maxTriangles,
                   "Largest scene accepted, in triangles (default 100000000; at most 4294967295, the 32-bit ids)")
         ->check(CLI::Range(uint64_t(1), uint64_t(UINT32_MAX)));
-    // At most 2048 (branch i16a's json::kMaxJsonDepthCeiling): tinygltf converts a glTF's extras and
-    // extensions recursively, about 0.5 KiB of stack per level in Release (it overflowed the 8 MiB
-    // stack between 15000 and 20000 levels), several times that under the sanitizers.
-    c->add_option("--max-json-depth", o.maxJsonDepth,
-                  "Deepest nesting of arrays and objects accepted in a JSON input (default 512, at most 2048)")
-        ->check(CLI::Range(uint64_t(1), uint64_t(2048)));
+    addJsonDepthOption(c, o);
 }
 
 void addAnalyzeOptions(CLI::App *c, Options &o) {

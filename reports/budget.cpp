@@ -134,9 +134,10 @@ const char *sectionFor(const std::string &metric) {
 
 }  // namespace
 
-bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err) {
+bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err,
+                uint64_t maxJsonDepth) {
     json::Doc doc;
-    if (!json::parseFile(path, &doc, err)) return false;
+    if (!json::parseFile(path, &doc, err, maxJsonDepth)) return false;
     const json::Json &root = doc.root;
     const json::Path top;
     if (!root.is_object()) {

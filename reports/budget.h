@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/depth_format.h"
+#include "analysis/limits.h"
 
 namespace va {
 
@@ -35,7 +36,8 @@ struct Budget {
 
 // Reads and validates a budget file: format "visaudit-budget/1", known metric names, limit types,
 // view names that exist in `viewNames`, depth format names. Messages: FILE:LINE:COL: place: what; fix.
-bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err);
+bool loadBudget(const std::string &path, const std::vector<std::string> &viewNames, Budget *out, std::string *err,
+                uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 
 // The depth formats a budget's min_depth_format limits name (each once, in file order; with
 // depth24plus also depth32float, WebGPU's other implementation of it): the z-fighting analysis

@@ -11,9 +11,9 @@ namespace va {
 
 using OJson = nlohmann::ordered_json;
 
-bool loadTolerances(const std::string &path, ToleranceRules *out, std::string *err) {
+bool loadTolerances(const std::string &path, ToleranceRules *out, std::string *err, uint64_t maxJsonDepth) {
     json::Doc doc;
-    if (!json::parseFile(path, &doc, err)) return false;
+    if (!json::parseFile(path, &doc, err, maxJsonDepth)) return false;
     const json::Path top;
     const json::Json &root = doc.root;
     if (!root.is_object() || !root.contains("format") || root["format"] != kToleranceFormat) {
@@ -72,15 +72,24 @@ bool isTiming(const std::string &k) { return k == "ms" || (k.size() > 3 && k.com
 
 // The numbers of one view a student must reproduce, as "stage.key" -> value, in report order.
 // Arrays and nested objects of numbers flatten with their index or key ("clip.per_plane.near",
-// "zbuffer_summary.histogram.3").
-void flatten(const std::string &prefix, const OJson &j, std::vector<std::pair<std::string, OJson>> *out) {
-    if (j.is_object()) {
-        for (const auto &[k, v] : j.items())
-            if (!isTiming(k) && k != "name" && k != "ran" && k != "reason") flatten(prefix + "." + k, v, out);
-    } else if (j.is_array()) {
-        for (size_t i = 0; i < j.size(); ++i) flatten(prefix + "." + std::to_string(i), j[i], out);
-    } else if (j.is_number() || j.is_null()) {
-        out->push_back({prefix, j});
+// "zbuffer_summary.histogram.3"). A submission is the student's file: the walk keeps its own stack
+// (depth-first, children in document order), never the call stack, whatever the nesting.
+void flatten(const std::string &prefix, const OJson &root, std::vector<std::pair<std::string, OJson>> *out) {
+    std::vector<std::pair<std::string, const OJson *>> todo{{prefix, &root}};
+    std::vector<std::pair<std::string, const OJson *>> children;
+    while (!todo.empty()) {
+        auto [name, j] = std::move(todo.back());
+        todo.pop_back();
+        children.clear();
+        if (j->is_object()) {
+            for (const auto &[k, v] : j->items())
+                if (!isTiming(k) && k != "name" && k != "ran" && k != "reason") children.push_back({name + "." + k, &v});
+        } else if (j->is_array()) {
+            for (size_t i = 0; i < j->size(); ++i) children.push_back({name + "." + std::to_string(i), &(*j)[i]});
+        } else if (j->is_number() || j->is_null()) {
+            out->push_back({name, *j});
+        }
+        todo.insert(todo.end(), std::make_move_iterator(children.rbegin()), std::make_move_iterator(children.rend()));
     }
 }
 

@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/limits.h"
+
 namespace va {
 
 constexpr const char *kToleranceFormat = "visaudit-tolerance/1";
@@ -24,7 +26,8 @@ struct ToleranceRules {
     bool hasDefault = false;
     Tolerance defaults;
 };
-bool loadTolerances(const std::string &path, ToleranceRules *out, std::string *err);
+bool loadTolerances(const std::string &path, ToleranceRules *out, std::string *err,
+                    uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 
 struct GradeItem {
     std::string view, stage, key;

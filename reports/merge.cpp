@@ -33,14 +33,15 @@ bool parseShard(const std::string &text, int *index, int *count, std::string *er
 
 namespace {
 
-bool readReport(const std::string &dir, Json *out, std::string *err) {
+bool readReport(const std::string &dir, Json *out, std::string *err, uint64_t maxJsonDepth) {
     const std::string path = (fs::path(dir) / "report.json").string();
     std::string detail;
-    switch (readJsonDocument(path, out, &detail)) {
+    switch (readJsonDocument(path, out, &detail, maxJsonDepth)) {
     case JsonRead::unreadable:
         *err = path + ": cannot be read; give the --out folder of an `analyze --shard K/N` run";
         return false;
     case JsonRead::invalid: *err = path + ": not valid JSON (" + detail + ")"; return false;
+    case JsonRead::tooDeep: *err = detail; return false;
     case JsonRead::ok: break;
     }
     if (!out->is_object() || !out->contains("format") || (*out)["format"] != kReportFormat) {
@@ -57,14 +58,15 @@ bool readReport(const std::string &dir, Json *out, std::string *err) {
 
 }  // namespace
 
-bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDir, Json *merged, std::string *err) {
+bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDir, Json *merged, std::string *err,
+                  uint64_t maxJsonDepth) {
     if (dirs.empty()) {
         *err = "merge needs the folders of the shard reports, e.g. visaudit merge shard1 shard2 --out merged";
         return false;
     }
     std::vector<Json> reports(dirs.size());
     for (size_t i = 0; i < dirs.size(); ++i)
-        if (!readReport(dirs[i], &reports[i], err)) return false;
+        if (!readReport(dirs[i], &reports[i], err, maxJsonDepth)) return false;
 
     // One analysis: same tool version, same scene, same shard count and view count.
     const Json &first = reports[0];

@@ -16,6 +16,8 @@
 
 #include "reports/report.h"
 
+#include "analysis/json_util.h"
+
 namespace va {
 
 namespace fs = std::filesystem;
@@ -236,14 +238,21 @@ OutputDir::~OutputDir() {
     }
 }
 
-JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, std::string *detail) {
+JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, std::string *detail,
+                          uint64_t maxDepth) {
     std::ifstream f(path, std::ios::binary);
     if (!f) return JsonRead::unreadable;
     std::stringstream ss;
     ss << f.rdbuf();
     if (!f && !f.eof()) return JsonRead::unreadable;
+    const std::string text = std::move(ss).str();
+    std::string deep;
+    if (!json::checkDepth(text, path, maxDepth, &deep)) {
+        if (detail) *detail = deep;
+        return JsonRead::tooDeep;
+    }
     try {
-        *out = nlohmann::ordered_json::parse(ss.str());
+        *out = nlohmann::ordered_json::parse(text);
     } catch (const std::exception &e) {
         if (detail) *detail = e.what();
         return JsonRead::invalid;

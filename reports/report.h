@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/limits.h"
 #include "analysis/results.h"
 
 namespace va {
@@ -109,8 +110,10 @@ void depthRange(const std::vector<double> &depth, double *dMin, double *dMax);
 // ---- Files and folders -----------------------------------------------------------------------
 // Reads and parses a JSON file (a report, a baseline, a submission). `unreadable`: the file cannot
 // be opened or read; `invalid`: not JSON, *detail gets the parser's message. Callers word the error.
-enum class JsonRead { ok, unreadable, invalid };
-JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, std::string *detail);
+// `tooDeep`: nested deeper than maxDepth (json::checkDepth), *detail gets the whole message.
+enum class JsonRead { ok, unreadable, invalid, tooDeep };
+JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, std::string *detail,
+                          uint64_t maxDepth = kDefaultMaxJsonDepth);
 
 // Writes a text file atomically (temporary name in the same folder, then rename).
 bool writeFileAtomic(const std::string &path, const std::string &contents, std::string *err);
