@@ -15,12 +15,15 @@
 //     reader on omerr and the face is not handed over; we count faces in the file ourselves to
 //     report the difference as dropped.
 //   - All readers store coordinates as float (Vec3f) except where a PLY declares double properties.
+#include <unistd.h>
+
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/Options.hh>
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -83,7 +86,7 @@ public:
         std::sort(distinct_.begin(), distinct_.end());
         if (std::unique(distinct_.begin(), distinct_.end()) - distinct_.begin() < 3) {
             ++m_->facesDropped;
-            ++tooFewFaces;
+            if (!tooFewFaces++) firstTooFew = uint64_t(fh.idx());
             return fh;
         }
         if (vs.size() > 3) ++m_->polygonsTriangulated;
@@ -144,6 +147,7 @@ public:
     size_t n_edges() const override { return 0; }
 
     uint64_t badIndexFaces = 0, tooFewFaces = 0;
+    uint64_t firstTooFew = 0;  // the first face with fewer than 3 distinct vertices (file order, from 0)
     struct {
         uint64_t face;      // the first face with an invalid index (file order, from 0)
         int64_t index;      // that index
@@ -259,6 +263,130 @@ std::string_view firstWord(std::string_view l) {
     size_t j = l.find_first_of(" \t", i);
     return l.substr(i, (j == std::string_view::npos ? l.size() : j) - i);
 }
+
+// An STL file's structure, checked before OpenMesh reads it (its readers stop quietly at a cut and
+// hand over what they had: an ASCII file cut inside its last facet loaded as 0 triangles, exit 0).
+// Binary (the size is 84 + 50 n for the count n in the header, OpenMesh's own test): nothing to
+// check. Otherwise a file that does not start with "solid" is a binary file whose size does not
+// match its count: truncated or padded. ASCII: every "facet" must run "outer loop", three
+// "vertex x y z", "endloop", "endfacet" (keywords case-insensitive, as the readers take them); a
+// file ending inside a facet, or a line out of that order, is refused at its line. `firstDegenerate`
+// receives the first facet with two equal vertices (OpenMesh skips those), or -1.
+bool checkStl(const std::string &path, int64_t *firstDegenerate, std::string *err) {
+    *firstDegenerate = -1;
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return true;  // the reader reports it
+    f.seekg(0, std::ios::end);
+    const uint64_t size = uint64_t(f.tellg());
+    f.seekg(0);
+    std::string text;
+    {
+        std::ostringstream ss;
+        ss << f.rdbuf();
+        text = std::move(ss).str();
+    }
+    if (size >= 84) {
+        uint32_t count;
+        std::memcpy(&count, text.data() + 80, 4);
+        if (84 + 50 * uint64_t(count) == size) {
+            // Binary: facet k is a normal and three corners (float x 3 each) and 2 attribute bytes.
+            for (uint64_t k = 0; k < count && *firstDegenerate < 0; ++k) {
+                float v[9];
+                std::memcpy(v, text.data() + 84 + 50 * k + 12, sizeof v);
+                auto same = [&](int a, int b) { return v[3 * a] == v[3 * b] && v[3 * a + 1] == v[3 * b + 1] && v[3 * a + 2] == v[3 * b + 2]; };
+                if (same(0, 1) || same(1, 2) || same(0, 2)) *firstDegenerate = int64_t(k);
+            }
+            return true;
+        }
+    }
+    const size_t start = text.find_first_not_of(" \t\r\n");
+    auto lower = [](std::string_view w) {
+        std::string l(w);
+        for (char &c : l) c = char(std::tolower((unsigned char)c));
+        return l;
+    };
+    if (start == std::string::npos || lower(std::string_view(text).substr(start, 5)) != "solid") {
+        if (size >= 84) {
+            uint32_t count;
+            std::memcpy(&count, text.data() + 80, 4);
+            *err = path + ": a binary STL whose header counts " + std::to_string(count) + " facets (" +
+                   std::to_string(84 + 50 * uint64_t(count)) + " bytes) but the file has " + std::to_string(size) +
+                   " bytes: it is truncated or damaged; export it again";
+        } else {
+            *err = path + ": " + std::to_string(size) +
+                   " bytes, shorter than a binary STL's 84-byte header, and not an ASCII STL (no 'solid'): the file "
+                   "is truncated or not an STL file";
+        }
+        return false;
+    }
+    // ASCII: the state is where in a facet the next line must be.
+    enum State { kOutside, kOuter, kVertex, kEndloop, kEndfacet } state = kOutside;
+    int vertices = 0;
+    int64_t facet = -1;
+    size_t facetLine = 0;
+    bool ok = true;
+    Vec3 corner[3];
+    forEachLine(text, [&](size_t line, std::string_view l) {
+        std::istringstream in{std::string(l)};
+        std::string word;
+        if (!(in >> word)) return true;  // blank
+        const std::string w = lower(word);
+        auto bad = [&](const std::string &what) {
+            *err = path + ":" + std::to_string(line) + ": " + what;
+            ok = false;
+            return false;
+        };
+        switch (state) {
+            case kOutside:
+                if (w == "facet") {
+                    ++facet, facetLine = line, state = kOuter;
+                } else if (w != "solid" && w != "endsolid") {
+                    return bad("'" + word + "' outside a facet; expected 'facet' (or 'endsolid')");
+                }
+                return true;
+            case kOuter:
+                if (w != "outer") return bad("facet " + std::to_string(facet) + ": expected 'outer loop', got '" + word + "'");
+                state = kVertex, vertices = 0;
+                return true;
+            case kVertex: {
+                if (w != "vertex")
+                    return bad("facet " + std::to_string(facet) + ": expected vertex " + std::to_string(vertices + 1) +
+                               " of 3, got '" + word + "'");
+                double x, y, z;
+                if (!(in >> x >> y >> z))
+                    return bad("facet " + std::to_string(facet) + ": vertex " + std::to_string(vertices + 1) +
+                               " needs 3 numbers, got '" + std::string(l.substr(l.find_first_not_of(" \t"))) + "'");
+                corner[vertices] = {x, y, z};
+                if (++vertices == 3) {
+                    state = kEndloop;
+                    if (*firstDegenerate < 0 &&
+                        (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]))
+                        *firstDegenerate = facet;
+                }
+                return true;
+            }
+            case kEndloop:
+                if (w != "endloop") return bad("facet " + std::to_string(facet) + ": expected 'endloop', got '" + word + "'");
+                state = kEndfacet;
+                return true;
+            case kEndfacet:
+                if (w != "endfacet") return bad("facet " + std::to_string(facet) + ": expected 'endfacet', got '" + word + "'");
+                state = kOutside;
+                return true;
+        }
+        return true;
+    });
+    if (!ok) return false;
+    if (state != kOutside) {
+        *err = path + ":" + std::to_string(facetLine) + ": facet " + std::to_string(facet) +
+               " is cut off: the file ends inside it (" +
+               (state == kVertex ? std::to_string(vertices) + " of its 3 vertices read" : std::string("before its end")) +
+               "); the file is truncated: export it again";
+        return false;
+    }
+    return true;
+}
+
 
 // OBJ checks where OpenMesh's reader is silent. Its reader parses a "v" line with iostream and skips
 // the vertex when that fails: "nan", "inf", an overflowing number or fewer than 3 coordinates. The
@@ -532,7 +660,11 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
 
 // PLY: the header's elements and properties, then every row of the body (ascii tokens or binary
 // bytes), each list length checked against what is left of the file.
-bool preCheckPly(const std::string &path, const std::string &text, std::string *err) {
+// `skipped` receives the header lines that are neither PLY keywords nor comments (old Blender
+// exports write a bare "Created by Blender3D 247 - www.blender.org" line; obj_info lines), which the
+// reference readers (rply, plyfile) skip: 1-based line numbers and their text.
+bool preCheckPly(const std::string &path, const std::string &text, std::string *err,
+                 std::vector<std::pair<size_t, std::string>> *skipped) {
     struct Property {
         int countBytes = 0;  // a list's length type; 0 for a scalar
         int bytes = 0;       // the (item) type's size
@@ -567,10 +699,11 @@ bool preCheckPly(const std::string &path, const std::string &text, std::string *
         if (line == 1) {
             if (w.size() != 1 || w[0] != "ply") return *err = path + ":1: expected 'ply', got '" + clip(l) + "'", false;
         } else if (w.empty() || w[0] == "comment") {
-        } else if (w[0] == "obj_info") {
-            // OpenMesh's header parser does not skip obj_info lines: it reads their words as keywords.
-            return *err = at + "obj_info lines are not supported (OpenMesh's reader misparses them); "
-                               "remove the line or make it a comment", false;
+        } else if (w[0] == "obj_info" || (w[0] != "format" && w[0] != "element" && w[0] != "property" &&
+                                            w[0] != "end_header" && w[0] != "ply")) {
+            // Not a keyword: skipped as the reference readers skip it (OpenMesh's header parser would
+            // read its words as keywords; loadMeshFile hands it a copy with these lines made comments).
+            skipped->push_back({line, std::string(l)});
         } else if (w[0] == "end_header") {
             body = e + 1;
         } else if (w[0] == "format" && w.size() == 3 && format.empty() && w[2] == "1.0" &&
@@ -741,10 +874,13 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
     }
 
     std::string text;
+    std::vector<std::pair<size_t, std::string>> plySkipped;  // PLY header lines skipped (line, text)
+    int64_t firstDegenerateFacet = -1;
+    if (ext == ".stl" && !checkStl(path, &firstDegenerateFacet, err)) return false;
     if (ext != ".stl") {
         if (!readAll(path, &text)) return fail(path + ": cannot read the file");
         if (ext == ".obj" && !preCheckObj(path, text, err)) return false;
-        if (ext == ".ply" && !preCheckPly(path, text, err)) return false;
+        if (ext == ".ply" && !preCheckPly(path, text, err, &plySkipped)) return false;
         if (ext == ".off" && !preCheckOff(path, text, err)) return false;
     }
 
@@ -758,15 +894,45 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
         std::lock_guard<std::mutex> lock(gOpenMeshMutex);
         CaptureOpenMeshLog capture;
         OpenMesh::IO::Options opt;  // positions and faces only
+        // A PLY header with skipped lines is read from a copy in which they are comments (the same
+        // number of lines; the body's bytes unchanged), written next to nothing the user owns.
+        std::string readPath = path;
+        std::filesystem::path copy;
+        if (!plySkipped.empty()) {
+            std::string fixed = text;
+            size_t pos = 0, line = 1, k = 0;
+            while (k < plySkipped.size() && pos < fixed.size()) {
+                if (line == plySkipped[k].first) {
+                    fixed.insert(pos, "comment ");
+                    ++k;
+                }
+                pos = fixed.find('\n', pos);
+                if (pos == std::string::npos) break;
+                ++pos, ++line;
+            }
+            static std::atomic<unsigned> counter{0};
+            copy = std::filesystem::temp_directory_path() /
+                   ("visaudit-ply-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".ply");
+            std::ofstream(copy, std::ios::binary) << fixed;
+            readPath = copy.string();
+        }
         try {
-            ok = OpenMesh::IO::IOManager().read(path, rec, opt);
+            ok = OpenMesh::IO::IOManager().read(readPath, rec, opt);
         } catch (const std::exception &e) {
             ok = false;
             log += std::string("exception: ") + e.what();
         }
+        if (!copy.empty()) {
+            std::error_code ec;
+            std::filesystem::remove(copy, ec);
+        }
         std::string t = capture.text();
         if (!t.empty()) log = log.empty() ? t : t + "; " + log;
     }
+    if (!plySkipped.empty())
+        m.warnings.push_back(path + ": " + std::to_string(plySkipped.size()) +
+                             " header line(s) that are not PLY keywords skipped, as the reference readers do (the "
+                             "first: line " + std::to_string(plySkipped[0].first) + ", '" + plySkipped[0].second + "')");
     // Collapse the reader's log into one line for our messages, and keep it short (a reader may log
     // once per bad face).
     for (auto &c : log)
@@ -799,7 +965,12 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
         m.facesRead = inFile;
         m.warnings.push_back(path + ": " + std::to_string(skipped) + " face(s) skipped by OpenMesh's " +
                              ext.substr(1) + " reader (" +
-                             (ext == ".stl" ? std::string("facets with repeated vertices, or a truncated file") : std::string("faces with repeated or out-of-range vertex indices")) +
+                             (ext == ".stl" ? std::string("facets with repeated vertices") +
+                                                  (firstDegenerateFacet >= 0 ? ", the first: facet " +
+                                                                                   std::to_string(firstDegenerateFacet) +
+                                                                                   " (counting from 0)"
+                                                                             : std::string())
+                                            : std::string("faces with repeated or out-of-range vertex indices")) +
                              "), counted as dropped");
     }
     if (rec.badIndexFaces)
@@ -816,7 +987,8 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
         }
     if (rec.tooFewFaces)
         m.warnings.push_back(path + ": " + std::to_string(rec.tooFewFaces) +
-                             " face(s) with fewer than 3 distinct vertices dropped");
+                             " face(s) with fewer than 3 distinct vertices dropped (the first: face " +
+                             std::to_string(rec.firstTooFew) + ", counting from 0)");
     if (!log.empty())
         m.warnings.push_back(path + ": reader said: " + log);
     if (m.positions.size() > std::numeric_limits<uint32_t>::max())

@@ -524,6 +524,7 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
 
     out->scenePath = scene.path;
     out->sceneStats = scene.stats;
+    out->sceneWarnings = scene.warnings;
     out->triangles = scene.objectTriangles.size();
     out->objects = scene.objects.size();
     out->sourceObjects = scene.sources.size();

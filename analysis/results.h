@@ -134,6 +134,8 @@ inline void releasePixelBuffers(ViewResult &v) {
 struct AnalysisResult {
     std::string scenePath;
     SceneStats sceneStats;
+    std::vector<std::string> sceneWarnings;  // the loaders' (dropped faces, ignored features) and
+                                             //   "no triangles to analyse"; also printed on stderr
     uint64_t triangles = 0;           // triangles analysed (source triangles minus excluded)
     uint64_t objects = 0;             // culling objects
     uint64_t sourceObjects = 0;

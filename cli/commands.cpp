@@ -45,6 +45,7 @@ namespace va {
 namespace {
 
 struct Options {
+    bool refuseEmptyScene = false;  // check: a scene with no triangle is exit 2, not an empty pass
     std::string scene;          // empty: the built-in demo
     std::string views;          // views file, "orbit:N", or empty (the scene's own)
     std::string out = "visaudit-report";
@@ -150,6 +151,23 @@ bool loadInputs(const Options &o, Scene *scene, std::vector<ViewSpec> *views) {
             return false;
         }
     }
+    // A scene with no triangle passes every budget: the worst result a CI gate can give. check
+    // refuses it; the other commands say so (stderr and the report's scene.warnings).
+    if (scene->objectTriangles.empty()) {
+        const std::string why =
+            scene->path + ": the scene has no triangle to analyse (" + std::to_string(scene->stats.sourceTriangles) +
+            " in the source, " + std::to_string(scene->stats.facesDropped) + " faces dropped by the loader, " +
+            std::to_string(scene->stats.degenerateTriangles) + " degenerate, " +
+            std::to_string(scene->stats.nonFiniteTriangles) + " non-finite)";
+        if (o.refuseEmptyScene) {
+            for (const std::string &w : scene->warnings) std::fprintf(stderr, "visaudit: warning: %s\n", w.c_str());
+            fail(why + "; check needs geometry to judge: fix the file or its export");
+            return false;
+        }
+        scene->warnings.push_back(why);
+    }
+    // Whatever a loader dropped or ignored is said, even with --quiet (it changes what is analysed).
+    for (const std::string &w : scene->warnings) std::fprintf(stderr, "visaudit: warning: %s\n", w.c_str());
     bool handled = false;
     if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err)) {
         fail(err);
@@ -269,6 +287,45 @@ int cmdInfo(const Options &o) {
     Scene scene;
     std::vector<ViewSpec> views;
     if (!loadInputs(o, &scene, &views)) return kExitBadInput;
+    if (o.json) {
+        nlohmann::ordered_json j;
+        j["scene"] = scene.path;
+        j["triangles"] = scene.objectTriangles.size();
+        j["source_triangles"] = scene.stats.sourceTriangles;
+        j["degenerate_triangles"] = scene.stats.degenerateTriangles;
+        j["non_finite_triangles"] = scene.stats.nonFiniteTriangles;
+        j["faces_dropped"] = scene.stats.facesDropped;
+        j["polygons_triangulated"] = scene.stats.polygonsTriangulated;
+        j["objects"] = scene.sources.size();
+        j["culling_objects"] = scene.objects.size();
+        if (scene.bounds.empty())
+            j["bounds"] = nullptr;
+        else
+            j["bounds"] = {{"min", {scene.bounds.lo.x, scene.bounds.lo.y, scene.bounds.lo.z}},
+                           {"max", {scene.bounds.hi.x, scene.bounds.hi.y, scene.bounds.hi.z}}};
+        j["up"] = std::string(1, scene.up);
+        nlohmann::ordered_json mats = nlohmann::ordered_json::array();
+        for (const Material &m : scene.materials)
+            mats.push_back({{"name", m.name},
+                            {"double_sided", m.doubleSided},
+                            {"transparent", m.transparent()},
+                            {"reflective", m.reflective > 0},
+                            {"refractive", m.refractive()}});
+        j["materials"] = mats;
+        j["lights"] = scene.lights.size();
+        nlohmann::ordered_json vs = nlohmann::ordered_json::array();
+        for (const ViewSpec &v : views)
+            vs.push_back({{"name", v.name},
+                          {"width", v.camera.width},
+                          {"height", v.camera.height},
+                          {"projection", v.camera.orthographic ? "orthographic" : "perspective"},
+                          {"eye", {v.camera.eye.x, v.camera.eye.y, v.camera.eye.z}},
+                          {"depth_format", depthFormatName(v.depthFormat)}});
+        j["views"] = vs;
+        j["warnings"] = scene.warnings;
+        std::printf("%s\n", j.dump(2).c_str());
+        return kExitOk;
+    }
     std::printf("scene       %s\n", scene.path.c_str());
     std::printf("triangles   %llu analysed of %llu in the source (%llu degenerate, %llu non-finite excluded)\n",
                 (unsigned long long)scene.objectTriangles.size(), (unsigned long long)scene.stats.sourceTriangles,
@@ -611,7 +668,9 @@ void addPvsAuditOptions(CLI::App *c, Options &o) {
     c->add_flag("--json", o.json, "Print the totals as JSON on stdout");
 }
 
-int cmdCheck(const Options &o) {
+int cmdCheck(const Options &in) {
+    Options o = in;
+    o.refuseEmptyScene = true;
     Budget budget;
     nlohmann::ordered_json baseline;
     std::string err;
@@ -898,6 +957,11 @@ void addSceneOptions(CLI::App *c, Options &o) {
     addJsonDepthOption(c, o);
 }
 
+void addInfoOptions(CLI::App *c, Options &o) {
+    addSceneOptions(c, o);
+    c->add_flag("--json", o.json, "Print the summary as JSON on stdout (the same fields; for scripts and tests)");
+}
+
 void addAnalyzeOptions(CLI::App *c, Options &o) {
     addSceneOptions(c, o);
     c->add_option("--out", o.out, "Output folder (written as a whole or not at all)");
@@ -972,7 +1036,7 @@ struct Command {
 };
 
 const Command kCommands[] = {
-    {"info", "Summarize a scene: triangles, objects, bounds, materials, views, degenerate faces", addSceneOptions,
+    {"info", "Summarize a scene: triangles, objects, bounds, materials, views, degenerate faces", addInfoOptions,
      cmdInfo},
     {"analyze", "Run every stage for every view; write report.json and images to --out", addAnalyzeOptions,
      cmdAnalyze},

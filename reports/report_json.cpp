@@ -603,6 +603,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
     scene["faces_dropped"] = r.sceneStats.facesDropped;
     scene["polygons_triangulated"] = r.sceneStats.polygonsTriangulated;
     scene["bounds"] = {{"min", vec3(r.bounds.lo)}, {"max", vec3(r.bounds.hi)}};
+    if (!r.sceneWarnings.empty()) scene["warnings"] = r.sceneWarnings;
     if (r.bsp) {
         const BspFaceCounts &f = r.bsp->faces;
         scene["bsp"] = {{"faces", f.faces},

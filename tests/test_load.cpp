@@ -147,8 +147,84 @@ TEST(LoadMesh, StlAsciiAndBinaryMergeVerticesAndCountSkippedFacets) {
         EXPECT_EQ(m.indices, idx({0, 1, 2, 1, 3, 2})) << f;
         ASSERT_EQ(m.warnings.size(), 1u) << f;
         EXPECT_EQ(m.warnings[0], kData + f + ": 1 face(s) skipped by OpenMesh's stl reader (facets with repeated "
-                                             "vertices, or a truncated file), counted as dropped");
+                                             "vertices, the first: facet 2 (counting from 0)), counted as dropped");
     }
+}
+
+// Issue 16: an ASCII STL cut off inside a facet loaded as 0 triangles with exit 0 (OpenMesh stops
+// quietly). Every cut is now refused at its line; a binary STL whose size does not match its count
+// too. The files are made here from a whole one.
+// Issue 16: old Blender exports write a bare header line ("Created by Blender3D 247 -
+// www.blender.org, source file: ..."); rply and plyfile skip lines that are not keywords, and so
+// does visaudit now (it was refused), saying what it skipped. ASCII and binary bodies alike.
+TEST(LoadMesh, PlyBareHeaderLinesAreSkippedAndSaid) {
+    const fs::path dir = fs::temp_directory_path() / "visaudit_ply_bare";
+    fs::create_directories(dir);
+    const std::string head = "ply\nformat %s 1.0\nCreated by Blender3D 247 - www.blender.org, source file: 'x.blend'\n"
+                             "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                             "obj_info num_cols 1\nproperty list uchar int vertex_indices\nend_header\n";
+    auto make = [&](const char *format) {
+        char buf[512];
+        std::snprintf(buf, sizeof buf, head.c_str(), format);
+        return std::string(buf);
+    };
+    std::string binary = make("binary_little_endian");
+    const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    binary.append(reinterpret_cast<const char *>(v), sizeof v);
+    const uint8_t n = 3;
+    const int32_t f[3] = {0, 1, 2};
+    binary.append(reinterpret_cast<const char *>(&n), 1);
+    binary.append(reinterpret_cast<const char *>(f), sizeof f);
+    for (const auto &[name, text] : {std::pair{std::string("ascii.ply"), make("ascii") + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+                                     std::pair{std::string("binary.ply"), binary}}) {
+        const std::string p = (dir / name).string();
+        std::ofstream(p, std::ios::binary) << text;
+        RawMesh m;
+        std::string err;
+        ASSERT_TRUE(loadMeshFile(p, &m, &err)) << err;
+        EXPECT_EQ(m.indices, idx({0, 1, 2})) << name;
+        ASSERT_EQ(m.warnings.size(), 1u) << name;
+        EXPECT_EQ(m.warnings[0], p + ": 2 header line(s) that are not PLY keywords skipped, as the reference readers do "
+                                     "(the first: line 3, 'Created by Blender3D 247 - www.blender.org, source file: "
+                                     "'x.blend'')");
+    }
+    fs::remove_all(dir);
+}
+
+TEST(LoadMesh, TruncatedStlIsRefusedAtItsPlace) {
+    const std::string whole = "solid t\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n"
+                              "  vertex 0 1 0\n endloop\nendfacet\nendsolid t\n";
+    const fs::path dir = fs::temp_directory_path() / "visaudit_stl_cut";
+    fs::create_directories(dir);
+    auto loadText = [&](const std::string &name, const std::string &text) {
+        const std::string p = (dir / name).string();
+        std::ofstream(p, std::ios::binary) << text;
+        RawMesh m;
+        std::string err;
+        const bool ok = loadMeshFile(p, &m, &err);
+        return std::pair{ok, err.empty() ? err : err.substr(err.find(name))};
+    };
+    EXPECT_TRUE(loadText("whole.stl", whole).first);
+    // Cut in the middle of the last vertex line: its numbers are short.
+    auto r = loadText("cut.stl", whole.substr(0, whole.find("vertex 0 1 0") + 10));
+    EXPECT_FALSE(r.first);
+    EXPECT_EQ(r.second, "cut.stl:6: facet 0: vertex 3 needs 3 numbers, got 'vertex 0 1'");
+    // Cut at a line end inside the facet: the file ends inside it.
+    r = loadText("cut2.stl", whole.substr(0, whole.find(" endloop")));
+    EXPECT_FALSE(r.first);
+    EXPECT_EQ(r.second, "cut2.stl:2: facet 0 is cut off: the file ends inside it (before its end); the file is "
+                        "truncated: export it again");
+    r = loadText("cut3.stl", whole.substr(0, whole.find("  vertex 0 1 0")));
+    EXPECT_EQ(r.second, "cut3.stl:2: facet 0 is cut off: the file ends inside it (2 of its 3 vertices read); the "
+                        "file is truncated: export it again");
+    // A binary STL one byte short of its count.
+    std::string bin(84 + 50, '\0');
+    bin[80] = 1;
+    r = loadText("short.stl", bin.substr(0, bin.size() - 1));
+    EXPECT_FALSE(r.first);
+    EXPECT_EQ(r.second, "short.stl: a binary STL whose header counts 1 facets (134 bytes) but the file has 133 bytes: "
+                        "it is truncated or damaged; export it again");
+    fs::remove_all(dir);
 }
 
 TEST(LoadMesh, MissingAndUnsupported) {

@@ -209,5 +209,49 @@ TEST_F(JsonNestingTest, TheCeilingIsSafeForEveryLaterWalk) {
         << r.err;
 }
 
+// Issue 16, silent loss: a file whose faces a loader drops says so on stderr (count, reason, first
+// place) and in the report; a scene left with no triangle is refused by check (exit 2: an empty
+// scene passes every budget) and flagged by analyze and info --json.
+TEST_F(JsonNestingTest, DroppedFacesAreSaidAndAnEmptySceneIsRefusedByCheck) {
+    const std::string one = write("one.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 1 2\nf 1 2 4\n");
+    const std::string none = write("none.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 1 2\n");
+    const std::string budget = write("b.json", R"({"format": "visaudit-budget/1", "views": {"*": {}}})");
+    const std::string dropped = ": 1 face(s) with fewer than 3 distinct vertices dropped (the first: face 1, counting from 0)";
+
+    auto r = runBinary({"analyze", one, "--views", "orbit:1", "--width", "16", "--height", "16", "--quiet", "--out",
+                        (dir_ / "a").string()},
+                       dir_);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("visaudit: warning: " + one + dropped), std::string::npos) << r.err;
+    auto report = nlohmann::ordered_json::parse(testing_util::slurpFile(dir_ / "a" / "report.json"));
+    EXPECT_EQ(report["scene"]["faces_dropped"], 1);
+    EXPECT_EQ(report["scene"]["warnings"], nlohmann::ordered_json::array({one + dropped}));
+
+    const std::string empty = none + ": the scene has no triangle to analyse (0 in the source, 1 faces dropped by the "
+                                     "loader, 0 degenerate, 0 non-finite)";
+    r = runBinary({"check", none, "--budget", budget, "--views", "orbit:1", "--out", (dir_ / "c").string()}, dir_);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("visaudit: error: " + empty + "; check needs geometry to judge: fix the file or its export"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "c"));
+
+    r = runBinary({"analyze", none, "--views", "orbit:1", "--width", "16", "--height", "16", "--quiet", "--out",
+                   (dir_ / "e").string()},
+                  dir_);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("visaudit: warning: " + empty), std::string::npos) << r.err;
+    report = nlohmann::ordered_json::parse(testing_util::slurpFile(dir_ / "e" / "report.json"));
+    EXPECT_EQ(report["scene"]["triangles"], 0);
+    EXPECT_EQ(report["scene"]["warnings"].back(), empty);
+
+    r = runBinary({"info", none, "--json"}, dir_);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto info = nlohmann::ordered_json::parse(r.out);
+    EXPECT_EQ(info["triangles"], 0);
+    EXPECT_EQ(info["faces_dropped"], 1);
+    EXPECT_EQ(info["warnings"].size(), 2u);
+}
+
 }  // namespace
 }  // namespace va
