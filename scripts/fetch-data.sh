@@ -85,9 +85,24 @@ for pair in openarena-088-data:pak6-patch088.pk3 openarena-081-maps:pak1-maps.pk
   echo "fetch-data: fetched $OA_OUT/$pk3 from $(basename "$deb")"
 done
 
-# 4. Draco, meshopt and quantized variants of the dungeon, made by real optimizers from the npm
+# 4. Another loader's test corpus (issue 16's peer oracle): assimp-testmodels' OBJ/PLY/OFF/STL/glTF/GLB
+#    files (with the .bin and textures they refer to), compared by tests/test_peer_corpus.cpp with
+#    `assimp info` (assimp-utils, installed by scripts/install-deps.sh).
+ASSIMP_OUT="$DATA/assimp"
+if [[ -s "$ASSIMP_OUT/STAMP" ]]; then
+  echo "fetch-data: $ASSIMP_OUT already present"
+else
+  deb="$(fetch_deb assimp-testmodels)"
+  rm -rf "$ASSIMP_OUT.part" && mkdir -p "$ASSIMP_OUT.part"
+  dpkg-deb --fsys-tarfile "$deb" | tar -x -C "$ASSIMP_OUT.part" --strip-components=4 ./usr/share/assimp/models
+  basename "$deb" > "$ASSIMP_OUT.part/STAMP"
+  rm -rf "$ASSIMP_OUT" && mv "$ASSIMP_OUT.part" "$ASSIMP_OUT"
+  echo "fetch-data: fetched $ASSIMP_OUT from $(basename "$deb")"
+fi
+
+# 5. Draco, meshopt and quantized variants of the dungeon, made by real optimizers from the npm
 #    registry (gltfpack, gltf-transform) at pinned versions: scripts/make-gltf-variants.sh.
 bash "$ROOT/scripts/make-gltf-variants.sh"
 
 echo "fetch-data: data in $DATA:"
-(cd "$DATA" && find . -type f \( -name '*.gltf' -o -name '*.glb' -o -name '*.bin' -o -name '*.off' -o -name '*.pk3' \) -printf '  %p (%s bytes)\n' | sort)
+(cd "$DATA" && find . -path ./assimp -prune -o -type f \( -name '*.gltf' -o -name '*.glb' -o -name '*.bin' -o -name '*.off' -o -name '*.pk3' \) -printf '  %p (%s bytes)\n' | sort)

@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake pkg-config ca-certificates
   libopenmesh-dev libembree-dev libcgal-dev libgmp-dev libmpfr-dev
   libopenimageio-dev nlohmann-json3-dev libcli11-dev libtbb-dev
-  libtinygltf-dev libstb-dev libzip-dev libdraco-dev libmeshoptimizer-dev
+  libtinygltf-dev libstb-dev libzip-dev libdraco-dev libmeshoptimizer-dev assimp-utils
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libopengl-dev libgl1-mesa-dri
   parallel
