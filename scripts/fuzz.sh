@@ -61,6 +61,13 @@ cp "$root"/tests/data/*.gltf "$seeds/small/gltf/"
 # Issue 16: a glTF whose extras nest past --max-json-depth (refused before tinygltf parses it).
 python3 -c 'import sys; n = 600; sys.stdout.write("{\"asset\":{\"version\":\"2.0\"},\"extras\":" + "[" * n + "]" * n + "}")' \
   > "$seeds/small/gltf/deep-extras.gltf"
+# ... and every other JSON target's input nested past it (scene, views, budget: json::checkDepth).
+python3 -c 'import sys; n = 600; sys.stdout.write("{\"format\":\"visaudit-scene/1\",\"x\":" + "[" * n + "]" * n + "}")' \
+  > "$seeds/small/scene_json/deep.scene.json"
+python3 -c 'import sys; n = 600; sys.stdout.write("{\"views\":[{\"x\":" + "[" * n + "]" * n + "}]}")' \
+  > "$seeds/small/views_json/deep.views.json"
+python3 -c 'import sys; n = 600; sys.stdout.write("{\"format\":\"visaudit-budget/1\",\"x\":" + "{\"a\":" * n + "1" + "}" * n + "}")' \
+  > "$seeds/small/budget_json/deep.budget.json"
 cp "$root"/tests/data/fuzz/* "$seeds/small/" 2>/dev/null || true
 if [ -f data/castle/level/level-dungeon.gltf ]; then
   cp data/castle/level/level-dungeon.gltf "$seeds/data/gltf/"
