@@ -88,6 +88,8 @@ private:
     std::string *err_;
     const uint8_t *lump_[kLumpCount] = {};
     uint64_t count_[kLumpCount] = {};  // records (bytes for byte lumps)
+    uint64_t badEffects_ = 0;          // faces naming an effect (fog volume) the file does not have
+    int64_t firstBadEffect_ = -1;      //   and the first of them
 
     bool fail(const std::string &m) {
         *err_ = name_ + ": " + m;
@@ -352,9 +354,13 @@ bool Parser::faces(std::vector<Face> *out) {
         if (f.shader < 0 || uint64_t(f.shader) >= count_[kShaders])
             return lumpFail(kFaces, face + " shader " + str(f.shader) + " is outside the " +
                                         str(int64_t(count_[kShaders])) + " shaders; the file is damaged");
-        if (f.effect < -1 || (f.effect >= 0 && uint64_t(f.effect) >= count_[kEffects]))
-            return lumpFail(kFaces, face + " effect " + str(f.effect) + " is outside the " +
-                                        str(int64_t(count_[kEffects])) + " effects; the file is damaged");
+        // The effect (a fog volume) is not geometry, and visaudit reads none; the engine does not
+        // check it either (ioquake3's R_LoadSurfaces takes fogNum + 1 as is), and shipped maps name
+        // effects their file lacks (OpenArena's aggressor: effect 0 of 0). Read as none, and said.
+        if (f.effect < -1 || (f.effect >= 0 && uint64_t(f.effect) >= count_[kEffects])) {
+            if (!badEffects_++) firstBadEffect_ = int64_t(i);
+            f.effect = -1;
+        }
         if (f.type == kBad || f.type == kBillboard) continue;  // no geometry is read from these
         if (!inRange(f.vertex, f.nVertexes, count_[kVertexes]))
             return lumpFail(kFaces, face + " vertex range " + range(f.vertex, f.nVertexes) + " exceeds " +
@@ -827,6 +833,11 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
                                 " sky, " + str(int64_t(fc.nodraw)) + " nodraw, " + str(int64_t(fc.nonSolid)) +
                                 " non-solid see-through, " + str(int64_t(fc.billboards)) + " billboard and " +
                                 str(int64_t(fc.bad)) + " bad faces");
+    if (badEffects_ > 0)
+        out->warnings.push_back(name_ + ": " + str(int64_t(badEffects_)) + " faces name an effect (fog volume) outside the " +
+                                str(int64_t(count_[kEffects])) + " effects of the file (the first: face " +
+                                str(firstBadEffect_) + "); read without one (effects are not geometry; the engine "
+                                "loads such maps)");
     if (fc.notDrawnEntity > 0) {
         uint64_t entities = 0;
         for (const BspModel &md : level->models) entities += md.notDrawnFaces > 0;

@@ -1143,6 +1143,20 @@ RawPvs rawPvs(const std::vector<uint8_t> &f) {
     return p;
 }
 
+// OpenArena's aggressor (pak1-maps) names effect 0 on a face although its effects lump is empty; the
+// engine loads it (ioquake3 does not check a face's fog number) and visaudit refused it as damaged.
+// Effects are not geometry: read as none, and said.
+TEST(Bsp, RealMapWithAnEffectItLacksLoads) {
+    REQUIRE_OA("pak1-maps.pk3");
+    const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/aggressor.bsp");
+    EXPECT_GT(s.triangleCount(), 0u);
+    bool said = false;
+    for (const std::string &w : s.warnings)
+        said = said || w.find("faces name an effect (fog volume) outside the 0 effects of the file (the first: face "
+                              "1209); read without one") != std::string::npos;
+    EXPECT_TRUE(said);
+}
+
 TEST(Bsp, RealQ3dm6ishPvsRowDecodedByHand) {
     REQUIRE_OA("pak1-maps.pk3");
     const Scene s = loadReal(kOa + "pak1-maps.pk3:maps/q3dm6ish.bsp");
