@@ -46,6 +46,7 @@ namespace {
 
 struct Options {
     bool refuseEmptyScene = false;  // check: a scene with no triangle is exit 2, not an empty pass
+    std::string images = "all";     // --images all|key|none
     std::string scene;          // empty: the built-in demo
     std::string views;          // views file, "orbit:N", or empty (the scene's own)
     std::string out = "visaudit-report";
@@ -415,11 +416,12 @@ int analyzeToReport(const Options &o,
     std::atomic<int> done{0};
     std::mutex printMutex;
     std::vector<double> imagesMs(views.size(), 0.0);  // per view: each slot written by one worker
+    const ImageSet imageSet = o.images == "none" ? ImageSet::none : o.images == "key" ? ImageSet::key : ImageSet::all;
     auto onView = [&](size_t i, ViewResult &v, std::string *e) {
         v.index = indices[i];
         v.imageBase = bases[i];
         const Stopwatch w0;
-        if (!writeViewImages(v, out.staging(), bases[i], e)) return false;
+        if (!writeViewImages(v, out.staging(), bases[i], e, imageSet)) return false;
         imagesMs[i] = w0.ms();
         releasePixelBuffers(v);  // the images hold them now
         const int k = ++done;
@@ -448,6 +450,7 @@ int analyzeToReport(const Options &o,
     if (afterRun)
         if (const int code = afterRun(scene, out.staging()); code != kExitOk) return code;
     result.loadMs = loadMs;
+    result.images = imageSet;
     OutputTimings outputMs;
     for (double ms : imagesMs) outputMs.imagesMs += ms;
     const Stopwatch r0;
@@ -965,6 +968,10 @@ void addInfoOptions(CLI::App *c, Options &o) {
 void addAnalyzeOptions(CLI::App *c, Options &o) {
     addSceneOptions(c, o);
     c->add_option("--out", o.out, "Output folder (written as a whole or not at all)");
+    c->add_option("--images", o.images,
+                  "Images written: all (default), key (per view the depth, overdraw, z-fighting and culling PNGs the "
+                  "page shows first), none (numbers only: report.json and report.html)")
+        ->check(CLI::IsMember({"all", "key", "none"}));
     c->add_option("--width", o.width, "Override every view's width in pixels")->check(CLI::Range(1, 1 << 30));
     c->add_option("--height", o.height, "Override every view's height in pixels")->check(CLI::Range(1, 1 << 30));
     c->add_option("--depth-format", o.depthFormat,

@@ -73,23 +73,45 @@ bool isTiming(const std::string &k) { return k == "ms" || (k.size() > 3 && k.com
 // The numbers of one view a student must reproduce, as "stage.key" -> value, in report order.
 // Arrays and nested objects of numbers flatten with their index or key ("clip.per_plane.near",
 // "zbuffer_summary.histogram.3"). A submission is the student's file: the walk keeps its own stack
-// (depth-first, children in document order), never the call stack, whatever the nesting.
+// (depth-first, children in document order), never the call stack, whatever the nesting. A node
+// keeps its key and its parent's index, and a name is joined only at a number: building every
+// inner node's full name would cost the square of the depth.
 void flatten(const std::string &prefix, const OJson &root, std::vector<std::pair<std::string, OJson>> *out) {
-    std::vector<std::pair<std::string, const OJson *>> todo{{prefix, &root}};
-    std::vector<std::pair<std::string, const OJson *>> children;
+    struct Node {
+        std::string key;  // "" for the root (the prefix)
+        size_t parent;    // index into `nodes`
+        const OJson *j;
+    };
+    std::vector<Node> nodes{{"", 0, &root}};
+    std::vector<size_t> todo{0}, children;
+    std::vector<const std::string *> keys;
     while (!todo.empty()) {
-        auto [name, j] = std::move(todo.back());
+        const size_t n = todo.back();
         todo.pop_back();
+        const OJson *j = nodes[n].j;
         children.clear();
         if (j->is_object()) {
             for (const auto &[k, v] : j->items())
-                if (!isTiming(k) && k != "name" && k != "ran" && k != "reason") children.push_back({name + "." + k, &v});
+                if (!isTiming(k) && k != "name" && k != "ran" && k != "reason") {
+                    children.push_back(nodes.size());
+                    nodes.push_back({k, n, &v});
+                }
         } else if (j->is_array()) {
-            for (size_t i = 0; i < j->size(); ++i) children.push_back({name + "." + std::to_string(i), &(*j)[i]});
+            for (size_t i = 0; i < j->size(); ++i) {
+                children.push_back(nodes.size());
+                nodes.push_back({std::to_string(i), n, &(*j)[i]});
+            }
         } else if (j->is_number() || j->is_null()) {
-            out->push_back({name, *j});
+            keys.clear();
+            for (size_t a = n; a != 0; a = nodes[a].parent) keys.push_back(&nodes[a].key);
+            std::string name = prefix;
+            for (auto k = keys.rbegin(); k != keys.rend(); ++k) {
+                name += '.';
+                name += **k;
+            }
+            out->push_back({std::move(name), *j});
         }
-        todo.insert(todo.end(), std::make_move_iterator(children.rbegin()), std::make_move_iterator(children.rend()));
+        todo.insert(todo.end(), children.rbegin(), children.rend());
     }
 }
 

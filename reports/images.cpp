@@ -219,7 +219,9 @@ uint8_t depthGray(double d, double dMin, double dMax) { return DepthGrayScale(dM
 // ---- Writing ----------------------------------------------------------------------------------
 
 bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
-                     std::string *err) {
+                     std::string *err, ImageSet set) {
+    auto want = [&](const char *key) { return imageWritten(set, key); };
+    if (set == ImageSet::none) return true;
     const ZBuffer &zb = view.buffer;
     const int W = zb.width, H = zb.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
@@ -233,7 +235,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     const std::string prefix = dir.empty() ? std::string() : (dir.back() == '/' ? dir : dir + "/");
 
     // BASE.depth.exr: view depth as float, +inf where nothing was drawn.
-    {
+    if (want("depth_exr")) {
         std::vector<float> z(n);
         for (size_t i = 0; i < n; ++i) z[i] = float(zb.depth[i]);
         ImageSpec spec(W, H, 1, TypeDesc::FLOAT);
@@ -243,7 +245,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     }
 
     // BASE.depth.png: log-scaled gray between the view's nearest and farthest finite depth.
-    {
+    if (want("depth_png")) {
         double dMin, dMax;
         depthRange(zb.depth, &dMin, &dMax);
         const DepthGrayScale scale(dMin, dMax);
@@ -256,7 +258,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.overdraw.png: heatmap of fragments per pixel, scale capped at max(8, most fragments), with
     // the legend in a strip below the image (the canvas widens if the legend is wider than the image).
-    {
+    if (want("overdraw_png")) {
         uint32_t maxFragments = 0;
         for (uint16_t f : zb.fragments) maxFragments = std::max<uint32_t>(maxFragments, f);
         const uint32_t cap = std::max<uint32_t>(8, maxFragments);
@@ -297,19 +299,19 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.ids.exr: 1 + visible source triangle index as UINT32 (OpenEXR's 32-bit unsigned pixel
     // type holds every id exactly, unlike a float channel, which would round ids above 2^24).
-    {
+    if (want("ids_exr")) {
         ImageSpec spec(W, H, 1, TypeDesc::UINT32);
         spec.channelnames = {"id"};
         if (!writeImageAtomic(prefix + names.idsExr, "openexr", spec, zb.id.data(), err)) return false;
     }
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
-    if (view.zfightRan && !writeZFightImage(view.zfight, zb, prefix + names.zfightPng, err)) return false;
+    if (view.zfightRan && want("zfight_png") && !writeZFightImage(view.zfight, zb, prefix + names.zfightPng, err)) return false;
     // BASE.culling.png: the reference visibility colored by each pixel's fate (reports/audit_images.h).
-    if (view.auditRan && !writeCullingImage(view.reference, view.cullAudit, prefix + names.cullingPng, err))
+    if (view.auditRan && want("culling_png") && !writeCullingImage(view.reference, view.cullAudit, prefix + names.cullingPng, err))
         return false;
     // Draw orders: painter's errors, overdraw by order, the A-buffer composite (reports/ordering_images.h).
-    if (view.orderingRan) {
+    if (view.orderingRan && set == ImageSet::all) {
         const OrderingImageNames on = orderingImageNames(names.base);
         if (!writePainterErrorsImage(view.reference, view.ordering.painter, prefix + on.painterErrorsPng, err) ||
             !writeOverdrawByOrderChart(view.ordering.overdrawByOrder, prefix + on.overdrawOrderPng, err))
@@ -318,14 +320,14 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
             return false;
     }
     // The raycast stage: its ids, and where it disagrees with the z-buffer (reports/audit_images.h).
-    if (view.raycastRan) {
+    if (view.raycastRan && set == ImageSet::all) {
         if (!writeRaycastIds(view.raycastImage.width, view.raycastImage.height, view.raycastImage.id,
                              prefix + names.raycastIdsExr, err) ||
             !writeRaycastDiffImage(zb, view.crossCheck, prefix + names.raycastDiffPng, err))
             return false;
     }
     // Secondary rays: one shadow image per light, the depth of the ray trees (reports/effects_images.h).
-    if (view.effectsRan) {
+    if (view.effectsRan && set == ImageSet::all) {
         for (size_t l = 0; l < view.effects.lights.size(); ++l)
             if (!writeShadowImage(view.effects, l, zb, prefix + shadowImageName(names, l, view), err)) return false;
         if (!writeSecondaryImage(view.effects, zb, prefix + names.secondaryPng, err)) return false;

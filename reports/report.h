@@ -72,7 +72,7 @@ void setImageThreads(int threads);
 // (each to a temporary name in dir, then renamed). Needs view.buffer (width x height). On failure
 // returns false with the path and OpenImageIO's message.
 bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
-                     std::string *err);
+                     std::string *err, ImageSet set = ImageSet::all);
 // As above with baseName = sanitizeFileName(view name): for a single view only; use
 // writeAllViewImages (or imageBaseNames) when view names may collide.
 bool writeViewImages(const ViewResult &view, const std::string &dir, std::string *err);

@@ -746,6 +746,13 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
             }
             vj["images"]["secondary_png"] = names.secondaryPng;
         }
+        // Only the images the run wrote (--images).
+        if (r.images != ImageSet::all) {
+            Json kept = Json::object();
+            for (auto it = vj["images"].begin(); it != vj["images"].end(); ++it)
+                if (imageWritten(r.images, it.key().c_str())) kept[it.key()] = it.value();
+            vj["images"] = kept;
+        }
         vj["total_ms"] = num(v.totalMs);
         views.push_back(vj);
     }

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -251,6 +252,39 @@ TEST_F(JsonNestingTest, DroppedFacesAreSaidAndAnEmptySceneIsRefusedByCheck) {
     EXPECT_EQ(info["triangles"], 0);
     EXPECT_EQ(info["faces_dropped"], 1);
     EXPECT_EQ(info["warnings"].size(), 2u);
+}
+
+// --images (issue 18): key writes per view the four PNGs the page shows first, none no image;
+// report.json lists exactly the files written and report.html refers to no missing file.
+TEST_F(JsonNestingTest, ImagesFlagWritesWhatTheReportLists) {
+    for (const std::string mode : {"all", "key", "none"}) {
+        const fs::path out = dir_ / ("img-" + mode);
+        const auto r = runBinary({"analyze", "--views", "orbit:2", "--width", "40", "--height", "30", "--quiet",
+                                  "--images", mode, "--out", out.string()},
+                                 dir_);
+        ASSERT_EQ(r.code, 0) << r.err;
+        const auto report = nlohmann::ordered_json::parse(testing_util::slurpFile(out / "report.json"));
+        std::set<std::string> listed, written;
+        for (const auto &v : report["views"])
+            for (auto it = v["images"].begin(); it != v["images"].end(); ++it) {
+                if (it.value().is_string()) listed.insert(it.value().get<std::string>());
+                else
+                    for (const auto &f : it.value()) listed.insert(f.get<std::string>());
+            }
+        for (const auto &e : fs::directory_iterator(out))
+            if (e.path().extension() == ".png" || e.path().extension() == ".exr") written.insert(e.path().filename().string());
+        EXPECT_EQ(listed, written) << mode;
+        const std::string html = testing_util::slurpFile(out / "report.html");
+        for (const std::string f : {"orbit0.ids.exr", "orbit0.painter_errors.png", "orbit0.depth.png"})
+            EXPECT_EQ(html.find("\"" + f + "\"") != std::string::npos && !written.count(f), false) << mode << " " << f;
+        if (mode == "all") EXPECT_EQ(written.size(), 20u);
+        if (mode == "key")
+            EXPECT_EQ(written, (std::set<std::string>{"orbit0.culling.png", "orbit0.depth.png", "orbit0.overdraw.png",
+                                                      "orbit0.zfight.png", "orbit1.culling.png", "orbit1.depth.png",
+                                                      "orbit1.overdraw.png", "orbit1.zfight.png"}));
+        if (mode == "none") EXPECT_TRUE(written.empty());
+    }
+    EXPECT_EQ(runBinary({"analyze", "--images", "some", "--out", (dir_ / "x").string()}, dir_).code, 2);
 }
 
 }  // namespace
