@@ -344,7 +344,13 @@ TEST(HardCases, EyeOnTheTrianglePlaneNeedsTheExactPredicate) {
 //    4294954410; n/d = 0.5 vs 0.33).
 TEST(HardCases, NearOneMicroFarOneBillionResolvesExactlyTheseSeparations) {
     using F = DepthFormat;
-    const std::vector<F> collapseFar = {F::unorm16, F::unorm24, F::unorm24_gl, F::f32};
+    // The formats issue 19 added collapse 40 and 50 with their models: reversed-Z on an integer
+    // buffer moves no bucket (unorm*_reversed: the keys of unorm*, reversed), WebGPU's
+    // depth32float and depth24plus are f32 and unorm24, and OpenGL's [-1, 1] range keeps float's
+    // rounding of z_ndc near 1 whether reversed or not (f32_gl, f32_gl_reversed: no clip control).
+    const std::vector<F> collapseFar = {F::unorm16,          F::unorm24,     F::unorm24_gl,  F::f32,
+                                        F::unorm16_reversed, F::unorm24_reversed, F::f32_gl, F::f32_gl_reversed,
+                                        F::depth32float,     F::depth24plus};
     const std::vector<F> collapseNear = {F::int31_inv, F::uint32_inv, F::log24};
     auto in = [](const std::vector<F> &l, F f) { return std::find(l.begin(), l.end(), f) != l.end(); };
     for (F f : allDepthFormats()) {
@@ -383,8 +389,10 @@ TEST(HardCases, NearOneMicroFarOneBillionResolvesExactlyTheseSeparations) {
 TEST(HardCases, NearOneMicroFarOneBillionThroughTheZBuffer) {
     const Scene scene = sceneOf({squareAt(-50, 100), squareAt(-40, 100)});
     for (DepthFormat f : allDepthFormats()) {
-        const bool collapses = f == DepthFormat::unorm16 || f == DepthFormat::unorm24 ||
-                               f == DepthFormat::unorm24_gl || f == DepthFormat::f32;
+        using F = DepthFormat;  // as the test above: the issue-19 formats collapse 40 and 50 too
+        const bool collapses = f == F::unorm16 || f == F::unorm24 || f == F::unorm24_gl || f == F::f32 ||
+                               f == F::unorm16_reversed || f == F::unorm24_reversed || f == F::f32_gl ||
+                               f == F::f32_gl_reversed || f == F::depth32float || f == F::depth24plus;
         ViewSpec view = axisView(8, 8, 90, 1e-6, 1e9);
         view.depthFormat = f;
         PipelineSettings s;
