@@ -18,6 +18,18 @@ int exactSide(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 e) {
     // counter-clockwise seen from e (checked: (0,0,0), (1,0,0), (0,1,0) from (0,0,1) is POSITIVE).
     return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
 }
+// The perspective filter: n.e + k in double, against a bound on its rounding error that covers the
+// computation of n and k from the vertices too (pbrt-style gamma bound, generous factor). The
+// magnitudes come precomputed per triangle (Scene::planeBounds), so the common case reads the plane
+// and two numbers, never the vertices. +1 front, -1 back, 0 undecided (the exact test decides).
+// eyeMax = maxAbs(eye).
+inline int filteredSide(const Scene &scene, uint32_t t, Vec3 eye, double eyeMax) {
+    const double *p = &scene.planes[4 * size_t(t)];
+    const double *b = &scene.planeBounds[2 * size_t(t)];
+    const double s = dot(Vec3{p[0], p[1], p[2]}, eye) + p[3];
+    const double err = gamma(12) * (b[0] * (eyeMax + b[1]));
+    return s > err ? 1 : (s < -err ? -1 : 0);
+}
 }  // namespace
 
 bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edgeOn) {
@@ -33,17 +45,8 @@ bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edge
         if (s == 0 && edgeOn) *edgeOn = true;
         return s > -err;
     }
-    // Filter: n.e + k in double, with a bound on its rounding error that covers the computation
-    // of n and k from the vertices too (pbrt-style gamma bound, generous factor).
-    // The magnitudes come precomputed per triangle (Scene::planeBounds: the same operations on the
-    // same values), so the common case reads the plane and two numbers, never the vertices.
     const Vec3 &e = cam.eye;
-    const double s = dot(n, e) + p[3];
-    const double *b = &scene.planeBounds[2 * size_t(t)];
-    const double mag = b[0] * (maxAbs(e) + b[1]);
-    const double err = gamma(12) * mag;
-    if (s > err) return true;
-    if (s < -err) return false;
+    if (const int side = filteredSide(scene, t, e, maxAbs(e)); side != 0) return side > 0;
     const uint32_t *ix = &scene.indices[3 * size_t(t)];
     const Vec3 v0 = scene.positions[ix[0]], v1 = scene.positions[ix[1]], v2 = scene.positions[ix[2]];
     const int side = exactSide(v0, v1, v2, e);
@@ -89,7 +92,6 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
     for (uint32_t o : objects) total += scene.objects[o].triEnd - scene.objects[o].triBegin;
     l.triangles.reserve(total);
     const double eyeMax = maxAbs(cam.eye);
-    const double kGamma12 = gamma(12);
     for (uint32_t o : objects) {
         const SceneObject &ob = scene.objects[o];
         const uint32_t begin = uint32_t(l.triangles.size());
@@ -100,19 +102,12 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
                                scene.objectTriangles.begin() + ob.triEnd);
         } else {
             st.trianglesTested += n;
-            // isFrontFacing's filter inlined for the perspective case (the same operations, so the
-            // same decisions); only where it cannot decide does the full test run.
+            // isFrontFacing's filter with the eye's magnitude taken once; only where it cannot
+            // decide does the full test run.
             const uint32_t *tris = scene.objectTriangles.data();
             for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) {
                 const uint32_t t = tris[i];
-                int side = 0;  // +1 front, -1 back, 0 undecided by the filter
-                if (!cam.orthographic) {
-                    const double *p = &scene.planes[4 * size_t(t)];
-                    const double *b = &scene.planeBounds[2 * size_t(t)];
-                    const double s = dot(Vec3{p[0], p[1], p[2]}, cam.eye) + p[3];
-                    const double err = kGamma12 * (b[0] * (eyeMax + b[1]));
-                    side = s > err ? 1 : (s < -err ? -1 : 0);
-                }
+                const int side = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
                 bool edgeOn = false;
                 if (side > 0 || (side == 0 && isFrontFacing(scene, t, cam, &edgeOn))) {
                     l.triangles.push_back(t);

@@ -201,37 +201,6 @@ std::string lowerExtension(const std::string &path) {
     return e;
 }
 
-// Facets in an STL file, counted independently of OpenMesh (which skips degenerate facets silently).
-// Binary: the 32-bit count after the 80-byte header when the file size matches 84 + 50n, exactly
-// OpenMesh's own test; otherwise ascii: lines whose first word is "outer".
-bool countStlFacets(const std::string &path, uint64_t *n) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return false;
-    f.seekg(0, std::ios::end);
-    const uint64_t size = uint64_t(f.tellg());
-    f.seekg(0);
-    if (size >= 84) {
-        char header[84];
-        f.read(header, 84);
-        uint32_t count;
-        std::memcpy(&count, header + 80, 4);  // little-endian on every platform we build for
-        if (84 + 50 * uint64_t(count) == size) {
-            *n = count;
-            return true;
-        }
-    }
-    f.clear();
-    f.seekg(0);
-    std::string line;
-    uint64_t c = 0;
-    while (std::getline(f, line)) {
-        size_t i = line.find_first_not_of(" \t\r");
-        if (i != std::string::npos && (line.compare(i, 5, "outer") == 0 || line.compare(i, 5, "OUTER") == 0)) ++c;
-    }
-    *n = c;
-    return true;
-}
-
 // Reads a whole file into memory (mesh files are read twice at most: once by OpenMesh, once here).
 bool readAll(const std::string &path, std::string *text) {
     std::ifstream f(path, std::ios::binary);
@@ -270,25 +239,20 @@ std::string_view firstWord(std::string_view l) {
 // check. Otherwise a file that does not start with "solid" is a binary file whose size does not
 // match its count: truncated or padded. ASCII: every "facet" must run "outer loop", three
 // "vertex x y z", "endloop", "endfacet" (keywords case-insensitive, as the readers take them); a
-// file ending inside a facet, or a line out of that order, is refused at its line. `firstDegenerate`
-// receives the first facet with two equal vertices (OpenMesh skips those), or -1.
-bool checkStl(const std::string &path, int64_t *firstDegenerate, std::string *err) {
+// file ending inside a facet, or a line out of that order, is refused at its line. `facets` receives
+// the file's facet count, counted independently of OpenMesh (which skips degenerate facets
+// silently), `firstDegenerate` the first facet with two equal vertices, or -1.
+bool checkStl(const std::string &path, uint64_t *facets, int64_t *firstDegenerate, std::string *err) {
+    *facets = 0;
     *firstDegenerate = -1;
-    std::ifstream f(path, std::ios::binary);
-    if (!f) return true;  // the reader reports it
-    f.seekg(0, std::ios::end);
-    const uint64_t size = uint64_t(f.tellg());
-    f.seekg(0);
     std::string text;
-    {
-        std::ostringstream ss;
-        ss << f.rdbuf();
-        text = std::move(ss).str();
-    }
+    if (!readAll(path, &text)) return true;  // the reader reports it
+    const uint64_t size = text.size();
     if (size >= 84) {
         uint32_t count;
-        std::memcpy(&count, text.data() + 80, 4);
+        std::memcpy(&count, text.data() + 80, 4);  // little-endian on every platform we build for
         if (84 + 50 * uint64_t(count) == size) {
+            *facets = count;
             // Binary: facet k is a normal and three corners (float x 3 each) and 2 attribute bytes.
             for (uint64_t k = 0; k < count && *firstDegenerate < 0; ++k) {
                 float v[9];
@@ -377,6 +341,7 @@ bool checkStl(const std::string &path, int64_t *firstDegenerate, std::string *er
         return true;
     });
     if (!ok) return false;
+    *facets = uint64_t(facet + 1);
     if (state != kOutside) {
         *err = path + ":" + std::to_string(facetLine) + ": facet " + std::to_string(facet) +
                " is cut off: the file ends inside it (" +
@@ -875,8 +840,9 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
 
     std::string text;
     std::vector<std::pair<size_t, std::string>> plySkipped;  // PLY header lines skipped (line, text)
+    uint64_t stlFacets = 0;
     int64_t firstDegenerateFacet = -1;
-    if (ext == ".stl" && !checkStl(path, &firstDegenerateFacet, err)) return false;
+    if (ext == ".stl" && !checkStl(path, &stlFacets, &firstDegenerateFacet, err)) return false;
     if (ext != ".stl") {
         if (!readAll(path, &text)) return fail(path + ": cannot read the file");
         if (ext == ".obj" && !preCheckObj(path, text, err)) return false;
@@ -948,8 +914,7 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err) {
     // header comment): those are counted as dropped.
     uint64_t inFile = m.facesRead;
     if (ext == ".stl") {
-        uint64_t n = 0;
-        if (countStlFacets(path, &n) && n > m.facesRead) inFile = n;
+        inFile = std::max<uint64_t>(inFile, stlFacets);
     } else if (ext == ".obj" || ext == ".off") {
         if (ext == ".obj") {
             uint64_t faceLines = 0;

@@ -370,11 +370,13 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
         os.abufferMaxList = s.limits.maxABufferList;
         r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer, os);
         r.orderingRan = true;
-        r.reference.fragmentCache = FragmentCache{};
-        r.reference.screen = ScreenTriangles{};
     } else {
         r.orderingReason = ps.orderingReason.empty() ? "needs the reference visibility" : ps.orderingReason;
     }
+    // The reference's screen triangles and fragments served the ordering audit only: a finished
+    // view keeps neither (estimateMemory's finishedViews).
+    r.reference.fragmentCache = FragmentCache{};
+    r.reference.screen = ScreenTriangles{};
 
     // Audit: detail -- triangles drawn against the pixels they show, too small, over-detailed.
     if (stopped()) return r;

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "analysis/audit.h"
@@ -132,20 +131,7 @@ inline void releasePixelBuffers(ViewResult &v) {
     freeMemory(v.effects.secondaryRays);
 }
 
-// Which images a run writes (--images): every one; the key ones (the page's first four per view:
-// depth, overdraw, z-fighting, culling fates, as PNGs); none (CI runs that need only the numbers).
-enum class ImageSet { all, key, none };
-// Whether the image under report key `key` (depth_png, ids_exr, ...) is written in `set`.
-inline bool imageWritten(ImageSet set, const char *key) {
-    if (set == ImageSet::all) return true;
-    if (set == ImageSet::none) return false;
-    for (const char *k : {"depth_png", "overdraw_png", "zfight_png", "culling_png"})
-        if (std::string_view(k) == key) return true;
-    return false;
-}
-
 struct AnalysisResult {
-    ImageSet images = ImageSet::all;  // what the output phase writes (report.json lists only those)
     std::string scenePath;
     SceneStats sceneStats;
     std::vector<std::string> sceneWarnings;  // the loaders' (dropped faces, ignored features) and

@@ -268,22 +268,28 @@ struct ReportTimes {
     double outputMs() const { return imagesMs + reportMs + htmlMs; }
     double sum() const { return loadMs + raySceneMs + bspMs + stagesMs + auditsMs + outputMs(); }
 };
-bool readReportTimes(const fs::path &p, ReportTimes *t, std::string *err) {
+// A report.json read whole; false with the reason when it is missing or not JSON.
+bool readReportJson(const fs::path &p, nlohmann::json *j, std::string *err) {
     std::ifstream f(p);
     if (!f) {
         *err = p.string() + ": not written";
         return false;
     }
-    nlohmann::json j;
     try {
-        f >> j;
+        f >> *j;
     } catch (const std::exception &e) {
         *err = p.string() + ": " + e.what();
         return false;
     }
-    auto num = [](const nlohmann::json &o, const char *k) {
-        return o.contains(k) && o[k].is_number() ? o[k].get<double>() : 0.0;
-    };
+    return true;
+}
+// A report's number field, 0 when the object or the key is absent.
+double num(const nlohmann::json &o, const char *k) {
+    return o.is_object() && o.contains(k) && o[k].is_number() ? o[k].get<double>() : 0.0;
+}
+bool readReportTimes(const fs::path &p, ReportTimes *t, std::string *err) {
+    nlohmann::json j;
+    if (!readReportJson(p, &j, err)) return false;
     t->loadMs = num(j, "load_ms");
     if (j.contains("effects")) t->raySceneMs = num(j["effects"], "ray_scene_build_ms");
     if (j.contains("bsp_tree") && j["bsp_tree"].is_object()) t->bspMs = num(j["bsp_tree"], "build_ms");
@@ -405,17 +411,8 @@ struct LevelParts {
     int width = 0, height = 0;
 };
 bool readLevelParts(const fs::path &p, LevelParts *t, std::string *err) {
-    std::ifstream f(p);
     nlohmann::json j;
-    try {
-        f >> j;
-    } catch (const std::exception &e) {
-        *err = p.string() + ": " + e.what();
-        return false;
-    }
-    auto num = [](const nlohmann::json &o, const char *k) {
-        return o.is_object() && o.contains(k) && o[k].is_number() ? o[k].get<double>() : 0.0;
-    };
+    if (!readReportJson(p, &j, err)) return false;
     t->load = num(j, "load_ms");
     if (j.contains("effects")) t->raySceneBuild = num(j["effects"], "ray_scene_build_ms");
     if (j.contains("bsp_tree")) t->bspBuild = num(j["bsp_tree"], "build_ms");

@@ -450,11 +450,10 @@ int analyzeToReport(const Options &o,
     if (afterRun)
         if (const int code = afterRun(scene, out.staging()); code != kExitOk) return code;
     result.loadMs = loadMs;
-    result.images = imageSet;
     OutputTimings outputMs;
     for (double ms : imagesMs) outputMs.imagesMs += ms;
     const Stopwatch r0;
-    *report = reportJson(result);
+    *report = reportJson(result, imageSet);
     outputMs.reportMs = r0.ms();
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was. A signal is honoured up to the

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -17,7 +18,19 @@ constexpr const char *kReportFormat = "visaudit-report/1";
 // The whole report as JSON (ordered keys, deterministic: no timestamps outside "ms" fields).
 // Doubles are always finite: a value that is not (an empty scene's bounds, a ratio over zero
 // pixels) is written as null; docs/report-schema.json says which fields can be null.
-nlohmann::ordered_json reportJson(const AnalysisResult &result);
+// Which images a run writes (--images): every one; the key ones (the page's first four per view:
+// depth, overdraw, z-fighting, culling fates, as PNGs); none (CI runs that need only the numbers).
+enum class ImageSet { all, key, none };
+// Whether the image under report key `key` (depth_png, ids_exr, ...) is written in `set`: the one
+// rule writeViewImages and reportJson's image lists follow.
+inline bool imageWritten(ImageSet set, std::string_view key) {
+    if (set == ImageSet::all) return true;
+    if (set == ImageSet::none) return false;
+    return key == "depth_png" || key == "overdraw_png" || key == "zfight_png" || key == "culling_png";
+}
+
+// `images`: the images the run wrote; each view's "images" lists only those.
+nlohmann::ordered_json reportJson(const AnalysisResult &result, ImageSet images = ImageSet::all);
 // The report's "totals" computed from its "views" array alone (reportJson and merge share it).
 nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views);
 

@@ -587,7 +587,7 @@ Json zbufferJson(const ZBufferStats &z) {
 
 }  // namespace
 
-nlohmann::ordered_json reportJson(const AnalysisResult &r) {
+nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
     Json j;
     j["format"] = kReportFormat;
     j["tool"] = {{"name", "visaudit"}, {"version", VISAUDIT_VERSION}};
@@ -747,10 +747,10 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r) {
             vj["images"]["secondary_png"] = names.secondaryPng;
         }
         // Only the images the run wrote (--images).
-        if (r.images != ImageSet::all) {
+        if (images != ImageSet::all) {
             Json kept = Json::object();
             for (auto it = vj["images"].begin(); it != vj["images"].end(); ++it)
-                if (imageWritten(r.images, it.key().c_str())) kept[it.key()] = it.value();
+                if (imageWritten(images, it.key())) kept[it.key()] = it.value();
             vj["images"] = kept;
         }
         vj["total_ms"] = num(v.totalMs);
