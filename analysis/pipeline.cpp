@@ -8,9 +8,9 @@
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
-#include "analysis/backface.h"
-#include "analysis/cells.h"
-#include "analysis/level_views.h"
+#include "analysis/stages/backface.h"
+#include "analysis/stages/cells.h"
+#include "analysis/load/level_views.h"
 #include "render/raster.h"
 #include "render/stopwatch.h"
 

@@ -104,7 +104,7 @@ struct BspLeaf {
     uint32_t firstLeafBrush = 0, leafBrushCount = 0;  // its brushes: BspLevel::leafBrushes[first, first + count)
 };
 
-// What the PVS audit (analysis/pvs_audit.h) reads besides the tree: shaders' flags, the brushes a
+// What the PVS audit (analysis/audits/pvs_audit.h) reads besides the tree: shaders' flags, the brushes a
 // leaf holds (a detail brush does not split the tree, so a point in a leaf with a cluster can still
 // be inside solid), and where each triangle came from.
 struct BspShader {
@@ -286,7 +286,7 @@ struct Scene {
     std::optional<BspLevel> bsp;          // Quake 3 maps: BSP tree, leafs, clusters, PVS, entities
     // Cells and portals (scene files only; empty: none). Per culling object, the cells its bounds
     // overlap: objectCells[objectCellsBegin[o] .. objectCellsBegin[o + 1]) (ascending; empty: in no
-    // cell, always kept). Filled by assignObjectsToCells (analysis/portals.h) once objects exist.
+    // cell, always kept). Filled by assignObjectsToCells (analysis/stages/portals.h) once objects exist.
     std::vector<Cell> cells;
     std::vector<Portal> portals;
     std::vector<uint32_t> objectCellsBegin;

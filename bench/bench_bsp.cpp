@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "analysis/effects_plan.h"
-#include "analysis/load.h"
-#include "analysis/ordering.h"
+#include "analysis/load/load.h"
+#include "analysis/audits/ordering.h"
 
 using namespace va;
 

@@ -1,5 +1,5 @@
 // The benchmark table of issue 8: every figure beside its peer, measured in the same run, on the
-// benchmark scene (analysis/bench_scene.h: 1,000,002 triangles, benchmarkCamera, 1920x1080).
+// benchmark scene (bench/bench_scene.h: 1,000,002 triangles, benchmarkCamera, 1920x1080).
 //
 //   bash bench/run.sh [--quick] [--sections LIST] [--reps N] [--keep]      (builds, then runs this)
 //   bench_table --visaudit PATH [same options]
@@ -45,10 +45,10 @@
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
-#include "analysis/backface.h"
-#include "analysis/bench_scene.h"
-#include "analysis/frustum.h"
-#include "analysis/load.h"
+#include "analysis/stages/backface.h"
+#include "bench/bench_scene.h"
+#include "analysis/stages/frustum.h"
+#include "analysis/load/load.h"
 #include "render/clip.h"
 #include "render/raster.h"
 #include "render/raycast.h"

@@ -1,4 +1,4 @@
-// z-buffer throughput on the benchmark scene (analysis/bench_scene.h), one thread and all threads.
+// z-buffer throughput on the benchmark scene (bench/bench_scene.h), one thread and all threads.
 //
 //   bench_zbuffer [--reps N] [--format NAME] [--tile-shift S] [--only K]
 //
@@ -20,7 +20,7 @@
 
 #include <tbb/global_control.h>
 
-#include "analysis/bench_scene.h"
+#include "bench/bench_scene.h"
 #include "render/clip.h"
 #include "render/raster.h"
 

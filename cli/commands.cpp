@@ -21,14 +21,14 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "analysis/demo.h"
-#include "analysis/depth_audit.h"
-#include "analysis/json_util.h"
-#include "analysis/level_views.h"
-#include "analysis/limits.h"
-#include "analysis/load.h"
+#include "analysis/load/demo.h"
+#include "analysis/audits/depth_audit.h"
+#include "common/json_util.h"
+#include "analysis/load/level_views.h"
+#include "common/limits.h"
+#include "analysis/load/load.h"
 #include "analysis/pipeline.h"
-#include "analysis/pvs_audit.h"
+#include "analysis/audits/pvs_audit.h"
 #include "reports/console.h"
 #include "reports/depth_audit_report.h"
 #include "reports/depth_plot.h"

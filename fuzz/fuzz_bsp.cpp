@@ -2,8 +2,8 @@
 // (buildScene, the spawn views). The triangle budget is lowered from 50 million to 2 million so a
 // header that asks for many patches is refused (the same check) instead of exhausting the fuzzer's
 // memory limit.
-#include "analysis/level_views.h"
-#include "analysis/load_bsp.h"
+#include "analysis/load/level_views.h"
+#include "analysis/load/load_bsp.h"
 #include "fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

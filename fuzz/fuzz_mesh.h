@@ -1,7 +1,7 @@
 // One mesh file through loadScene (loadMeshFile, then buildScene), as `visaudit analyze x.EXT` reads
 // it (glTF and GLB through fuzz_gltf.h). Included by fuzz_obj.cpp, fuzz_ply.cpp, fuzz_off.cpp and
 // fuzz_stl.cpp with VISAUDIT_FUZZ_EXT.
-#include "analysis/load.h"
+#include "analysis/load/load.h"
 #include "fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

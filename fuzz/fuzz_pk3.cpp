@@ -1,7 +1,7 @@
-// Zip archives (.pk3) through analysis/zip.h: list the members, read each of the first eight (the
+// Zip archives (.pk3) through analysis/load/zip.h: list the members, read each of the first eight (the
 // size limit lowered to 16 MB for the fuzzer's memory limit), then look up a missing member, which
 // walks the names for the message's suggestions.
-#include "analysis/zip.h"
+#include "analysis/load/zip.h"
 #include "fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

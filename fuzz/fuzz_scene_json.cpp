@@ -1,7 +1,7 @@
 // Scene JSON (visaudit-scene/1) through loadScene: the JSON reader, the meshes it names and
 // buildScene. The example meshes sit next to the input as meshes/*, so the seeds
 // (examples/*.scene.json) load whole and mutations reach every key.
-#include "analysis/load.h"
+#include "analysis/load/load.h"
 #include "fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerInitialize(int *, char ***) {

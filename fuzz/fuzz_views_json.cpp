@@ -1,5 +1,5 @@
 // Views files ({ "views": [ ... ] }) through loadViewsFile, with a z-up scene's default.
-#include "analysis/load.h"
+#include "analysis/load/load.h"
 #include "fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

@@ -52,7 +52,7 @@ struct ZBufferSettings {
     DepthEncoder encoder;       // the view's depth format bound to its near/far
     bool orthographic = false;  // how DepthPlane values turn into view depth
 
-    // Options for the audits (analysis/audit.h); the defaults are the plain z-buffer and cost
+    // Options for the audits (analysis/audits/audit.h); the defaults are the plain z-buffer and cost
     // nothing (exactDepth selects another instantiation; the pointers are tested once a triangle).
     //
     // exactDepth: the depth test compares the double view depth (LESS: on equal depths the first

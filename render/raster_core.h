@@ -1,6 +1,6 @@
 // The fragment core of the rasterizer: which pixel centers each screen triangle covers, and the
 // view depth of each such fragment. Every pass that needs fragments -- the z-buffer (raster.cpp),
-// the reference visibility (analysis/audit.cpp), the two-nearest-surfaces pass of the z-fighting
+// the reference visibility (analysis/audits/audit.cpp), the two-nearest-surfaces pass of the z-fighting
 // audit, later an A-buffer and the painter's algorithm -- walks coverage through this one template,
 // so all of them see exactly the same fragments (docs/rasterizer.md: Coverage, Depth).
 //

@@ -1,4 +1,4 @@
-// Images of the audits (analysis/audit.h), next to each view's other images (reports/report.h):
+// Images of the audits (analysis/audits/audit.h), next to each view's other images (reports/report.h):
 //
 //   BASE.culling.png       the reference visibility, each pixel colored by the fate of its visible
 //                          triangle: drawn (gray, shaded by depth like depth.png), falsely culled by
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/audit.h"
+#include "analysis/audits/audit.h"
 #include "reports/report.h"
 
 namespace va {

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "analysis/json_util.h"
+#include "common/json_util.h"
 #include "render/depth_format.h"
 
 namespace va {

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/depth_format.h"
-#include "analysis/limits.h"
+#include "common/limits.h"
 
 namespace va {
 

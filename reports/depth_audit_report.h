@@ -1,4 +1,4 @@
-// Console table and JSON of the depth-format audit (analysis/depth_audit.h), for the
+// Console table and JSON of the depth-format audit (analysis/audits/depth_audit.h), for the
 // `visaudit depth-audit` command. Field meanings: docs/depth-formats.md.
 #pragma once
 
@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/depth_audit.h"
+#include "analysis/audits/depth_audit.h"
 
 namespace va {
 

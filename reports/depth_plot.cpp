@@ -212,7 +212,7 @@ bool writeDepthResolutionPlot(const DepthAuditResult &r, const std::string &path
     c.rect(L.left, L.top, L.left, L.bottom, kFrame);
     c.rect(L.right, L.top, L.right, L.bottom, kFrame);
 
-    // The fight distances (analysis/depth_audit.h), under the curves: a dashed line at each gap and
+    // The fight distances (analysis/audits/depth_audit.h), under the curves: a dashed line at each gap and
     // at twice each gap (where a curve crosses them, buckets get wider than the gap: the onset;
     // twice as wide: likely).
     auto dashed = [&](double value, const std::string &label) {

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "analysis/depth_audit.h"
+#include "analysis/audits/depth_audit.h"
 #include "reports/report.h"
 
 namespace va {

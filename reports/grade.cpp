@@ -5,7 +5,7 @@
 #include <map>
 #include <sstream>
 
-#include "analysis/json_util.h"
+#include "common/json_util.h"
 
 namespace va {
 

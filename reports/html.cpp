@@ -30,7 +30,7 @@
 #include <string_view>
 #include <vector>
 
-#include "analysis/depth_audit.h"
+#include "analysis/audits/depth_audit.h"
 #include "render/depth_format.h"
 #include "reports/depth_plot.h"
 #include "reports/html_assets.h"
@@ -522,7 +522,7 @@ std::string scatterSvg(const std::vector<ScatterPoint> &pts, const std::string &
 }
 
 // Depth resolution (m) against view depth (m), log-log, one curve per depth format for this view's
-// near/far (analysis/depth_audit.h: the formats' exact arithmetic, the same curves as
+// near/far (analysis/audits/depth_audit.h: the formats' exact arithmetic, the same curves as
 // `visaudit depth-audit`); the view's own format drawn thick, dashed markers at the hotspots'
 // depths. Colors are depthPlotColor's (the same as depth-audit.png).
 std::string resolutionSvg(const DepthAuditResult &r, const std::string &ownFormat,

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/limits.h"
+#include "common/limits.h"
 
 namespace va {
 

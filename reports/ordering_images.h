@@ -1,4 +1,4 @@
-// Images of the ordering analysis (analysis/ordering.h; docs/ordering.md), next to each view's other
+// Images of the ordering analysis (analysis/audits/ordering.h; docs/ordering.md), next to each view's other
 // images:
 //
 //   BASE.painter_errors.png  the reference visibility shaded by depth (gray, dimmed), every pixel the
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/ordering.h"
+#include "analysis/audits/ordering.h"
 #include "reports/report.h"
 
 namespace va {

@@ -16,7 +16,7 @@
 
 #include "reports/report.h"
 
-#include "analysis/json_util.h"
+#include "common/json_util.h"
 
 namespace va {
 

@@ -1,4 +1,4 @@
-// The outputs of `visaudit pvs-audit` (analysis/pvs_audit.h; docs/pvs-audit.md): pvs-audit.json
+// The outputs of `visaudit pvs-audit` (analysis/audits/pvs_audit.h; docs/pvs-audit.md): pvs-audit.json
 // (versioned), pvs-audit.png (the level from above, colored by slack and misses, with a legend),
 // pvs-audit.html (one self-contained page) and a console summary. `check` writes the same three
 // files next to report.json when its budget names a pvs_* metric.
@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/pvs_audit.h"
+#include "analysis/audits/pvs_audit.h"
 
 namespace va {
 

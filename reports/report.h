@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/limits.h"
+#include "common/limits.h"
 #include "analysis/results.h"
 
 namespace va {

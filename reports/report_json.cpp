@@ -249,7 +249,7 @@ Json drawStatsJson(const DrawStats &d) {
             {"depth_complexity", num(d.depthComplexity)}, {"ms", num(d.ms)}};
 }
 
-// Draw orders and exact orders (analysis/ordering.h; docs/ordering.md).
+// Draw orders and exact orders (analysis/audits/ordering.h; docs/ordering.md).
 Json orderingJson(const OrderingResult &o) {
     Json j;
     j["ran"] = true;
@@ -414,7 +414,7 @@ Json cameraJson(const CameraSpec &c) {
     return j;
 }
 
-// The evidence of a map's PVS false culls (analysis/pvs_evidence.h; docs/quake3.md, "Reading the
+// The evidence of a map's PVS false culls (analysis/audits/pvs_evidence.h; docs/quake3.md, "Reading the
 // evidence"). Bounded by the kEvidence* limits; every list says what it left out.
 Json pvsEvidenceJson(const PvsEvidence &e) {
     auto leafs = [](const std::vector<PvsLeafBit> &ls) {
@@ -465,7 +465,7 @@ Json pvsEvidenceJson(const PvsEvidence &e) {
             {"objects_omitted", e.objectsOmitted}};
 }
 
-// The audit against the reference visibility (analysis/audit.h; docs/audits.md).
+// The audit against the reference visibility (analysis/audits/audit.h; docs/audits.md).
 Json auditJson(const ViewResult &v) {
     const ReferenceVisibility &ref = v.reference;
     const CullAudit &a = v.cullAudit;
@@ -518,7 +518,7 @@ Json auditJson(const ViewResult &v) {
     return j;
 }
 
-// The per-view z-fighting analysis (analysis/zfight.h; docs/zfighting.md).
+// The per-view z-fighting analysis (analysis/audits/zfight.h; docs/zfighting.md).
 Json depthJson(const ZFightResult &z, double ms) {
     Json j;
     j["ran"] = true;
@@ -561,7 +561,7 @@ Json depthJson(const ZFightResult &z, double ms) {
                       {"pair_pixels", h.pairPixels},
                       {"pairs", h.pairs},
                       {"formats", fj},
-                      // Why it fights (analysis/zfight.h explainHotspot; docs/zfighting.md).
+                      // Why it fights (analysis/audits/zfight.h explainHotspot; docs/zfighting.md).
                       {"view_bucket_width", h.viewBucketWidth ? num(*h.viewBucketWidth) : Json(nullptr)},
                       {"cheapest_format",
                        h.cheapestFormat ? Json(depthFormatInfo(*h.cheapestFormat).name) : Json(nullptr)},

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/zfight.h"
+#include "analysis/audits/zfight.h"
 #include "render/raster.h"
 #include "reports/report.h"
 

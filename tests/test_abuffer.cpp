@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "analysis/demo.h"
+#include "analysis/load/demo.h"
 #include "analysis/effects_plan.h"
-#include "analysis/load.h"
-#include "analysis/ordering.h"
+#include "analysis/load/load.h"
+#include "analysis/audits/ordering.h"
 #include "render/abuffer.h"
 #include "render/raster_core.h"
 

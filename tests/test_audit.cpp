@@ -1,4 +1,4 @@
-// The audits (analysis/audit.h): reference visibility, false culls and wasted draws, and the
+// The audits (analysis/audits/audit.h): reference visibility, false culls and wasted draws, and the
 // z-buffer against the ray caster, on the demo scene, the example hall, the fetched levels and
 // analytic scenes; plus ray-casting watertightness.
 //
@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "analysis/audit.h"
-#include "analysis/backface.h"
-#include "analysis/demo.h"
-#include "analysis/frustum.h"
-#include "analysis/load.h"
+#include "analysis/audits/audit.h"
+#include "analysis/stages/backface.h"
+#include "analysis/load/demo.h"
+#include "analysis/stages/frustum.h"
+#include "analysis/load/load.h"
 #include "render/clip.h"
 #include "render/raster.h"
 #include "render/raycast.h"

@@ -14,15 +14,15 @@
 #include <set>
 #include <unistd.h>
 
-#include "analysis/audit.h"
-#include "analysis/backface.h"
-#include "analysis/cells.h"
-#include "analysis/level_views.h"
-#include "analysis/load.h"
-#include "analysis/load_bsp.h"
+#include "analysis/audits/audit.h"
+#include "analysis/stages/backface.h"
+#include "analysis/stages/cells.h"
+#include "analysis/load/level_views.h"
+#include "analysis/load/load.h"
+#include "analysis/load/load_bsp.h"
 #include "analysis/pipeline.h"
-#include "analysis/pvs_evidence.h"
-#include "analysis/zip.h"
+#include "analysis/audits/pvs_evidence.h"
+#include "analysis/load/zip.h"
 
 using namespace va;
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-// The BSP tree (analysis/bsp_tree.h): exact plane classification, splits, the hard cases of the
+// The BSP tree (analysis/audits/bsp_tree.h): exact plane classification, splits, the hard cases of the
 // ordering issue (cyclic overlap, interpenetration, a vertex on a splitting plane, coplanar
 // triangles, a scene far from the origin, a closed mesh from inside and outside), and traversal
 // against the reference visibility. Suite BspTree*.
@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "tests/test_util.h"
-#include "analysis/audit.h"
-#include "analysis/bsp_tree.h"
-#include "analysis/demo.h"
-#include "analysis/load.h"
-#include "analysis/ordering.h"
+#include "analysis/audits/audit.h"
+#include "analysis/audits/bsp_tree.h"
+#include "analysis/load/demo.h"
+#include "analysis/load/load.h"
+#include "analysis/audits/ordering.h"
 
 namespace va {
 namespace {

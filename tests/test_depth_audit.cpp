@@ -1,4 +1,4 @@
-// The depth-format audit (analysis/depth_audit.h), its table and JSON, and its plot: hand-computed
+// The depth-format audit (analysis/audits/depth_audit.h), its table and JSON, and its plot: hand-computed
 // resolutions, exact distinct-value counts, inverse round trips over wide magnitudes, fight
 // predicates and onsets against analytic bounds, bad input, and the PNG read back through OIIO.
 #include <gtest/gtest.h>
@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "analysis/depth_audit.h"
-#include "analysis/zfight.h"
+#include "analysis/audits/depth_audit.h"
+#include "analysis/audits/zfight.h"
 #include "reports/budget.h"
 #include "reports/depth_audit_report.h"
 #include "reports/depth_plot.h"

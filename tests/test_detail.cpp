@@ -1,13 +1,13 @@
-// The detail audit (analysis/detail.h): exact counts on a box seen face-on orthographically, a
+// The detail audit (analysis/audits/detail.h): exact counts on a box seen face-on orthographically, a
 // dense far sphere flagged "too small", a dense mid-distance sphere flagged "over-detailed" with
 // the triangles a coarser level of detail saves, computed here from the reference visibility.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "analysis/audit.h"
-#include "analysis/demo.h"
-#include "analysis/detail.h"
+#include "analysis/audits/audit.h"
+#include "analysis/load/demo.h"
+#include "analysis/audits/detail.h"
 #include "render/clip.h"
 #include "render/raster.h"
 

@@ -12,9 +12,9 @@
 
 #include <tbb/global_control.h>
 
-#include "analysis/demo.h"
+#include "analysis/load/demo.h"
 #include "analysis/effects_plan.h"
-#include "analysis/load.h"
+#include "analysis/load/load.h"
 #include "render/effects.h"
 
 using namespace va;

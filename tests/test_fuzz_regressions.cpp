@@ -4,7 +4,7 @@
 //   - OFF and PLY: a count larger than the file (a face's corners, a list's length) or a header
 //     OpenMesh cannot parse drove a read loop on a failed stream for up to 2^32 iterations (a hang);
 //   - every mesh read leaked 96 bytes in OpenMesh's log streams (connect/disconnect).
-// analysis/load_mesh.cpp now checks each file's structure before OpenMesh's reader sees it.
+// analysis/load/load_mesh.cpp now checks each file's structure before OpenMesh's reader sees it.
 #include <gtest/gtest.h>
 
 #include <OpenMesh/Core/System/omstream.hh>
@@ -13,7 +13,7 @@
 #include <fstream>
 #include <unistd.h>
 
-#include "analysis/load.h"
+#include "analysis/load/load.h"
 
 using namespace va;
 namespace fs = std::filesystem;

@@ -19,7 +19,7 @@
 #include <map>
 #include <tuple>
 
-#include "analysis/load.h"
+#include "analysis/load/load.h"
 #include "tests/run_binary.h"
 #include "tests/temp_dir_test.h"
 

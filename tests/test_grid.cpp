@@ -1,4 +1,4 @@
-// The grid stage (analysis/grid.h): exact counts on a hand-made lattice of boxes seen by a known
+// The grid stage (analysis/stages/grid.h): exact counts on a hand-made lattice of boxes seen by a known
 // orthographic frustum, the automatic cell size, and a seeded property test: every object the grid
 // culls is entirely outside the frustum (no point of its box inside), over perspective views.
 #include <gtest/gtest.h>
@@ -8,12 +8,12 @@
 #include <filesystem>
 #include <random>
 
-#include "analysis/audit.h"
-#include "analysis/load.h"
+#include "analysis/audits/audit.h"
+#include "analysis/load/load.h"
 
-#include "analysis/demo.h"
-#include "analysis/frustum.h"  // worldFrustumPlanes
-#include "analysis/grid.h"
+#include "analysis/load/demo.h"
+#include "analysis/stages/frustum.h"  // worldFrustumPlanes
+#include "analysis/stages/grid.h"
 
 namespace va {
 namespace {

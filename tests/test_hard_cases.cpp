@@ -16,9 +16,9 @@
 #include <limits>
 #include <sstream>
 
-#include "analysis/backface.h"
-#include "analysis/demo.h"
-#include "analysis/load.h"
+#include "analysis/stages/backface.h"
+#include "analysis/load/demo.h"
+#include "analysis/load/load.h"
 #include "analysis/pipeline.h"
 #include "render/depth_format.h"
 #include "tests/temp_dir_test.h"

@@ -1,4 +1,4 @@
-// Resource limits (analysis/limits.h, docs/limits.md): each limit refuses input that would exceed it
+// Resource limits (common/limits.h, docs/limits.md): each limit refuses input that would exceed it
 // with the number it needed, the limit and the flag that raises it, before the memory is allocated
 // (the program's peak memory, from wait4, proves "before"); the flag lets the input through.
 // Suite Limits*.
@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "analysis/demo.h"
-#include "analysis/limits.h"
-#include "analysis/load.h"
+#include "analysis/load/demo.h"
+#include "common/limits.h"
+#include "analysis/load/load.h"
 #include "analysis/pipeline.h"
 #include "render/abuffer.h"
 #include "tests/run_binary.h"

@@ -1,4 +1,4 @@
-// The occlusion stage (analysis/occlusion.h): the max-depth pyramid, a big wall that hides exactly
+// The occlusion stage (analysis/stages/occlusion.h): the max-depth pyramid, a big wall that hides exactly
 // the boxes behind it and none beside or peeking past it, and 0 false culls against the reference
 // visibility on the demo, the example hall, the three rooms and the castle dungeon (orbit and
 // inside views).
@@ -9,11 +9,11 @@
 #include <filesystem>
 #include <limits>
 
-#include "analysis/audit.h"
-#include "analysis/demo.h"
-#include "analysis/frustum.h"
-#include "analysis/load.h"
-#include "analysis/occlusion.h"
+#include "analysis/audits/audit.h"
+#include "analysis/load/demo.h"
+#include "analysis/stages/frustum.h"
+#include "analysis/load/load.h"
+#include "analysis/stages/occlusion.h"
 
 namespace va {
 namespace {

@@ -1,4 +1,4 @@
-// Draw order (analysis/ordering.h): the painter's algorithm against the reference, Newell's pair
+// Draw order (analysis/audits/ordering.h): the painter's algorithm against the reference, Newell's pair
 // tests, overdraw under each draw order, the ordering table on the demo and the dungeon, and the
 // ordering images. Suite Ordering*.
 #include <gtest/gtest.h>
@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "tests/test_util.h"
-#include "analysis/demo.h"
+#include "analysis/load/demo.h"
 #include "analysis/effects_plan.h"
-#include "analysis/load.h"
-#include "analysis/ordering.h"
+#include "analysis/load/load.h"
+#include "analysis/audits/ordering.h"
 #include "render/raster_core.h"
 #include "reports/ordering_images.h"
 

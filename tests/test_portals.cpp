@@ -1,4 +1,4 @@
-// The portal cells stage (analysis/portals.h) and the scene file's "cells" and "portals" keys:
+// The portal cells stage (analysis/stages/portals.h) and the scene file's "cells" and "portals" keys:
 // the three-rooms example with exact visible cells and culled objects for four cameras, a portal
 // seen edge-on, nested portals narrowing to nothing, a camera outside every cell, the clipper, the
 // object-to-cell assignment, bad input with exact messages, and 0 false culls against the
@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "analysis/audit.h"
-#include "analysis/demo.h"
-#include "analysis/load.h"
-#include "analysis/portals.h"
+#include "analysis/audits/audit.h"
+#include "analysis/load/demo.h"
+#include "analysis/load/load.h"
+#include "analysis/stages/portals.h"
 
 namespace va {
 namespace {

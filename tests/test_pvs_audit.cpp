@@ -1,4 +1,4 @@
-// The PVS audit (analysis/pvs_audit.h, docs/pvs-audit.md): hand-built maps with a known miss, a known
+// The PVS audit (analysis/audits/pvs_audit.h, docs/pvs-audit.md): hand-built maps with a known miss, a known
 // crack miss and known slack (exact counts), the far plane, the BSP segment walk, the player's eye
 // box, the loader's brushes, a real map checked against its own bytes, determinism across thread
 // counts, the command's files and messages, and `check` gating on pvs_misses.
@@ -14,10 +14,10 @@
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
-#include "analysis/load.h"
-#include "analysis/load_bsp.h"
-#include "analysis/pvs_audit.h"
-#include "analysis/zip.h"
+#include "analysis/load/load.h"
+#include "analysis/load/load_bsp.h"
+#include "analysis/audits/pvs_audit.h"
+#include "analysis/load/zip.h"
 #include "reports/budget.h"
 #include "reports/pvs_audit_report.h"
 #include "tests/bsp_writer.h"

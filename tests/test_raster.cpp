@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "analysis/bench_scene.h"
+#include "bench/bench_scene.h"
 #include "render/clip.h"
 #include "render/depth_format.h"
 #include "render/raster.h"

@@ -16,7 +16,7 @@
 
 #include <tbb/task_arena.h>
 
-#include "analysis/bench_scene.h"
+#include "bench/bench_scene.h"
 #include "render/clip.h"
 #include "render/raster.h"
 

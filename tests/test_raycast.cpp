@@ -11,7 +11,7 @@
 
 #include <tbb/global_control.h>
 
-#include "analysis/demo.h"
+#include "analysis/load/demo.h"
 #include "tests/test_util.h"
 #include "analysis/scene.h"
 #include "render/raycast.h"

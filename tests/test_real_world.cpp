@@ -11,8 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "analysis/json_util.h"
-#include "analysis/limits.h"
+#include "common/json_util.h"
+#include "common/limits.h"
 #include "reports/grade.h"
 #include "reports/report.h"
 #include "tests/run_binary.h"

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <random>
 
-#include "analysis/backface.h"
-#include "analysis/demo.h"
+#include "analysis/stages/backface.h"
+#include "analysis/load/demo.h"
 #include "tests/test_util.h"
-#include "analysis/frustum.h"
+#include "analysis/stages/frustum.h"
 #include "analysis/pipeline.h"
 
 using namespace va;

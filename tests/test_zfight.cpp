@@ -1,4 +1,4 @@
-// Z-fighting analysis (analysis/zfight.h, reports/zfight_image.h; rules in docs/zfighting.md).
+// Z-fighting analysis (analysis/audits/zfight.h, reports/zfight_image.h; rules in docs/zfighting.md).
 //
 // Most cases look straight down (-y) at horizontal quads from a camera at height h with a 90 degree
 // field of view on a 64 x 64 image, up = -z. Then:
@@ -19,11 +19,11 @@
 
 #include <unistd.h>
 
-#include "analysis/backface.h"
-#include "analysis/demo.h"
-#include "analysis/frustum.h"
-#include "analysis/load.h"
-#include "analysis/zfight.h"
+#include "analysis/stages/backface.h"
+#include "analysis/load/demo.h"
+#include "analysis/stages/frustum.h"
+#include "analysis/load/load.h"
+#include "analysis/audits/zfight.h"
 #include "render/clip.h"
 #include "reports/zfight_image.h"
 

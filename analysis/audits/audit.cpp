@@ -1,0 +1,504 @@
+// Audits against the truth (audit.h; the definitions and constants are derived in docs/audits.md).
+#include "analysis/audits/audit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <unordered_map>
+
+#include "analysis/stages/backface.h"
+#include "render/raster.h"
+#include "render/raster_core.h"
+#include "render/stopwatch.h"
+
+namespace va {
+
+namespace {
+
+
+// The reference as a fragment sink: single-sided triangles only with the front winding, LESS on
+// the double depth with ties to the lowest id (so the order of submission does not matter).
+struct ReferenceSink {
+    const Scene &scene;
+    const Camera &cam;
+    const int32_t *xy;  // the screen triangles' fixed-point corners
+    const uint32_t *source;
+    const uint8_t *singleSided;
+    uint32_t *id;
+    double *depth;
+    uint8_t *snappedFront;
+    FragmentCache *cache;  // null: not recorded
+    uint64_t cacheMax = 0;
+    uint32_t current = 0;  // 1 + source of the triangle being walked
+    uint64_t backWinding = 0, fragments = 0;
+    bool overflow = false;
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const uint32_t s = source[t];
+        if (singleSided[s] && !frontWinding) {
+            ++backWinding;
+            return false;
+        }
+        if (singleSided[s] && isSnappedSliver(t) && !isFrontFacing(scene, s, cam)) snappedFront[s] = 1;
+        current = s + 1;
+        return true;
+    }
+    // Whether snapping can have flipped the winding of front-wound screen triangle t. Each corner
+    // is the projected point rounded to the nearest fixed-point unit (toFixed), so each component
+    // of the edges e1 = v1 - v0, e2 = v2 - v0 is off by at most 1 unit, and twice the area
+    // A = e1.x e2.y - e1.y e2.x by at most |e1.x| + |e1.y| + |e2.x| + |e2.y| + 2 (the projection's
+    // own rounding, relative 2^-50 of coordinates below 2^30, adds far less than the + 2 more of
+    // slack). The exact winding can only differ from the snapped one (A < 0: front) when |A| is
+    // within that bound. The exact test runs only then: slivers are rare, so it costs nothing.
+    bool isSnappedSliver(size_t t) const {
+        const int32_t *v = xy + 6 * t;
+        const int64_t e1x = int64_t(v[2]) - v[0], e1y = int64_t(v[3]) - v[1];
+        const int64_t e2x = int64_t(v[4]) - v[0], e2y = int64_t(v[5]) - v[1];
+        const int64_t area = e1x * e2y - e1y * e2x;
+        return -area <= std::abs(e1x) + std::abs(e1y) + std::abs(e2x) + std::abs(e2y) + 4;
+    }
+    void fragment(size_t i, size_t, double d) {
+        if (cache && !overflow) {
+            if (cache->pixel.size() == cacheMax) {
+                overflow = true;
+            } else {
+                cache->pixel.push_back(uint32_t(i));
+                cache->depth.push_back(d);
+            }
+        }
+        const double old = depth[i];
+        if (d < old || (d == old && current < id[i])) {
+            depth[i] = d;
+            id[i] = current;
+        }
+    }
+    void endTriangle(size_t t, uint64_t n) {
+        fragments += n;
+        if (cache) cache->begin[t + 1] = cache->pixel.size();
+    }
+};
+
+// Unit roundoff of float (Embree's arithmetic) and pbrt's gamma(n) = n u / (1 - n u): a bound on
+// the relative error of n successive roundings.
+constexpr double kFloatU = 0x1p-24;
+constexpr double gammaF(int n) { return n * kFloatU / (1 - n * kFloatU); }
+
+// A triangle seen from the camera: view-space vertices and the float-frame magnitudes the ray
+// caster's error depends on.
+struct ViewTriangle {
+    Vec3 P[3];           // view space
+    double M[3];         // |vertex - frame origin| + |eye - frame origin| (world units)
+    DepthPlane plane;
+};
+
+ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t) {
+    ViewTriangle v;
+    const double eyeFrame = length(cam.eye - rayOrigin);
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 w = scene.positions[scene.indices[3 * size_t(t) + i]];
+        v.P[i] = transformPoint(cam.viewFromWorld, w);
+        v.M[i] = length(w - rayOrigin) + eyeFrame;
+    }
+    v.plane = depthPlaneFromView(cam, v.P[0], v.P[1], v.P[2]);
+    return v;
+}
+
+// The ray caster's depth error for triangle v at (px, py), depth d: the hit point's error across
+// the plane (vertices and ray origin rounded to float: sqrt(3) u M each; the intersection's own
+// arithmetic: gamma(kEmbreeEdgeOps) of the magnitudes, t |D| and |Q|), turned into an error along
+// the ray by 1 / |n.D| (a grazing ray moves far along itself for a small move across the plane).
+double rayDepthError(const Camera &cam, const ViewTriangle &v, double px, double py, double d) {
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const Vec3 n = cross(v.P[1] - v.P[0], v.P[2] - v.P[0]);
+    const double nl = length(n);
+    double maxM = 0, maxQ = 0;
+    for (int i = 0; i < 3; ++i) {
+        maxM = std::max(maxM, v.M[i]);
+        maxQ = std::max(maxQ, length(v.P[i] - r.origin));
+    }
+    const double across = std::sqrt(3.0) * kFloatU * maxM + gammaF(kEmbreeEdgeOps) * (d * length(r.direction) + maxQ);
+    const double cosine = nl > 0 ? std::fabs(dot(n, r.direction)) / nl : 0;
+    return cosine > 0 ? across / cosine + kFloatU * d : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+// ---- Reference visibility ----------------------------------------------------------------------
+
+std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
+    std::vector<uint8_t> s(scene.triangleCount(), 0);
+    for (const SceneObject &o : scene.objects) {
+        if (scene.materialOf(o).doubleSided) continue;
+        for (uint32_t k = o.triBegin; k < o.triEnd; ++k) s[scene.objectTriangles[k]] = 1;
+    }
+    return s;
+}
+
+ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments) {
+    const Stopwatch t0;
+    ReferenceVisibility r;
+    r.width = std::max(cam.width, 0);
+    r.height = std::max(cam.height, 0);
+    const size_t pixels = size_t(r.width) * size_t(r.height);
+
+    // Every object's triangles, one clip batch per object (its vertex range is transformed once).
+    std::vector<ClipBatch> batches;
+    batches.reserve(scene.objects.size());
+    for (const SceneObject &o : scene.objects) {
+        if (o.triEnd == o.triBegin) continue;
+        batches.push_back({o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
+        r.trianglesIn += o.triEnd - o.triBegin;
+    }
+    r.screen = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    const ScreenTriangles &screen = r.screen;
+    r.screenTriangles = screen.size();
+
+    r.id.assign(pixels, 0);
+    r.depth.assign(pixels, std::numeric_limits<double>::infinity());
+    const std::vector<uint8_t> single = singleSidedTriangles(scene);
+    r.snappedFront.assign(scene.triangleCount(), 0);
+    FragmentCache &cache = r.fragmentCache;
+    if (maxCachedFragments) {
+        cache.begin.assign(screen.size() + 1, 0);
+        // Reserved whole, so it never reallocates (pages are touched only as fragments arrive).
+        cache.pixel.reserve(maxCachedFragments);
+        cache.depth.reserve(maxCachedFragments);
+    }
+    const Stopwatch tr;
+    ReferenceSink sink{scene,        cam,           screen.xy.data(),       screen.source.data(),
+                       single.data(), r.id.data(),  r.depth.data(),         r.snappedFront.data(),
+                       maxCachedFragments ? &cache : nullptr, maxCachedFragments};
+    forEachFragment(screen, r.width, r.height, cam.orthographic, sink);
+    if (sink.overflow) {
+        cache = FragmentCache{};
+    } else if (maxCachedFragments) {
+        // Triangles the walk skipped (no endTriangle) hold no fragment: begin[t + 1] = begin[t].
+        for (size_t t = 0; t < screen.size(); ++t) cache.begin[t + 1] = std::max(cache.begin[t + 1], cache.begin[t]);
+        cache.rasterMs = tr.ms();
+    }
+    r.backWinding = sink.backWinding;
+    r.fragments = sink.fragments;
+    for (uint8_t f : r.snappedFront) r.snappedFrontTriangles += f;
+
+    r.pixelsOf.assign(scene.triangleCount(), 0);
+    for (uint32_t id : r.id)
+        if (id) {
+            ++r.pixelsOf[id - 1];
+            ++r.coveredPixels;
+        }
+    std::vector<uint8_t> objectVisible(scene.objects.size(), 0);
+    for (size_t t = 0; t < r.pixelsOf.size(); ++t)
+        if (r.pixelsOf[t]) {
+            ++r.visibleTriangles;
+            objectVisible[scene.triangleObject[t]] = 1;
+        }
+    for (uint8_t v : objectVisible) r.visibleObjects += v;
+    r.ms = t0.ms();
+    return r;
+}
+
+// ---- False culls and wasted draws ---------------------------------------------------------------
+
+double pixelPointDistance(const Camera &cam, size_t pixel, double depth) {
+    const size_t w = size_t(std::max(cam.width, 1));
+    const ViewRay r = viewRayThroughPixel(cam, double(pixel % w) + 0.5, double(pixel / w) + 0.5);
+    return length(r.origin + r.direction * depth);
+}
+
+CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const std::vector<StageCulls> &stages,
+                       const std::vector<uint32_t> &drawnTriangles, const std::vector<uint32_t> *fragmentsPerSource,
+                       const Camera *cam) {
+    const Stopwatch t0;
+    CullAudit a;
+    const size_t nt = scene.triangleCount();
+
+    // The stage that culled each triangle first (1 + index; 0 = none). A per-pixel fate is a byte,
+    // 5 + k, so at most 251 stages (the pipeline has 5 culling stages).
+    const size_t nStages = std::min<size_t>(stages.size(), 255 - kFateCulledFirst + 1);
+    std::vector<uint8_t> culledBy(nt, 0);
+    a.stages.resize(nStages);
+    for (size_t k = 0; k < nStages; ++k) {
+        StageCullAudit &sa = a.stages[k];
+        sa.stage = stages[k].stage;
+        sa.objectsCulled = stages[k].objects.size();
+        auto cull = [&](uint32_t t) {
+            if (t < nt && culledBy[t] == 0 && scene.triangleObject[t] != kExcludedTriangle) {
+                culledBy[t] = uint8_t(k + 1);
+                ++sa.trianglesCulled;
+            }
+        };
+        for (uint32_t o : stages[k].objects) {
+            if (o >= scene.objects.size()) continue;
+            const SceneObject &ob = scene.objects[o];
+            for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) cull(scene.objectTriangles[i]);
+        }
+        for (uint32_t t : stages[k].triangles) cull(t);
+    }
+
+    // A triangle culled by a facing stage that the reference shows only through snapping.
+    auto isSnapped = [&](size_t t, size_t k) {
+        return stages[k].byFacing && t < ref.snappedFront.size() && ref.snappedFront[t];
+    };
+
+    // Pixels of culled triangles: their point's distance from the eye, for the nearest false cull,
+    // and beyond a stage's design far plane, hidden by design (beyondPx: per triangle, such pixels;
+    // beyond: per pixel). One pass over the pixels, only with a camera.
+    std::vector<uint32_t> beyondPx;
+    std::vector<uint8_t> beyond;
+    bool anyFarPlane = false;
+    for (size_t k = 0; k < nStages; ++k) {
+        a.stages[k].designFarPlane = cam ? std::max(stages[k].designFarPlane, 0.0) : 0.0;
+        anyFarPlane |= a.stages[k].designFarPlane > 0;
+    }
+    if (cam && !ref.pixelsOf.empty()) {
+        if (anyFarPlane) beyondPx.assign(nt, 0), beyond.assign(ref.id.size(), 0);
+        for (size_t i = 0; i < ref.id.size(); ++i) {
+            const uint32_t id = ref.id[i];
+            if (!id || !culledBy[id - 1] || isSnapped(id - 1, culledBy[id - 1] - 1)) continue;
+            StageCullAudit &sa = a.stages[culledBy[id - 1] - 1];
+            const double d = pixelPointDistance(*cam, i, ref.depth[i]);
+            if (sa.designFarPlane > 0 && d > sa.designFarPlane) {
+                ++beyondPx[id - 1];
+                beyond[i] = 1;
+                if (sa.beyondFarPlaneNearest == 0 || d < sa.beyondFarPlaneNearest) sa.beyondFarPlaneNearest = d;
+            } else if (sa.falseCullNearest == 0 || d < sa.falseCullNearest) {
+                sa.falseCullNearest = d;
+            }
+        }
+    }
+
+    // False culls: culled triangles that the reference shows (at a pixel within the stage's design
+    // far plane, when it has one); aggregated per object for the worst-offender lists.
+    struct Agg {
+        uint64_t triangles = 0, pixels = 0;
+    };
+    std::vector<std::unordered_map<uint32_t, Agg>> perObject(nStages);
+    for (size_t t = 0; t < nt; ++t) {
+        if (!culledBy[t] || !ref.pixelsOf.size() || ref.pixelsOf[t] == 0) continue;
+        const size_t k = culledBy[t] - 1;
+        StageCullAudit &sa = a.stages[k];
+        if (isSnapped(t, k)) {
+            ++sa.snappedTriangles;
+            sa.snappedPixels += ref.pixelsOf[t];
+            continue;
+        }
+        const uint64_t far = beyondPx.empty() ? 0 : beyondPx[t], near = ref.pixelsOf[t] - far;
+        sa.beyondFarPlanePixels += far;
+        if (near == 0) {
+            ++sa.beyondFarPlaneTriangles;
+            continue;
+        }
+        ++sa.falseCullTriangles;
+        sa.falseCullPixels += near;
+        Agg &g = perObject[k][scene.triangleObject[t]];
+        ++g.triangles;
+        g.pixels += near;
+    }
+    for (size_t k = 0; k < nStages; ++k) {
+        StageCullAudit &sa = a.stages[k];
+        sa.falseCullObjects = perObject[k].size();
+        for (const auto &[o, g] : perObject[k]) sa.worst.push_back({o, scene.objects[o].name, g.triangles, g.pixels});
+        std::sort(sa.worst.begin(), sa.worst.end(), [](const FalseCullOffender &x, const FalseCullOffender &y) {
+            if (x.pixels != y.pixels) return x.pixels > y.pixels;
+            if (x.triangles != y.triangles) return x.triangles > y.triangles;
+            return x.object < y.object;
+        });
+        if (sa.worst.size() > kWorstOffenders) sa.worst.resize(kWorstOffenders);
+        a.falseCullTriangles += sa.falseCullTriangles;
+        a.falseCullPixels += sa.falseCullPixels;
+        a.beyondFarPlaneTriangles += sa.beyondFarPlaneTriangles;
+        a.beyondFarPlanePixels += sa.beyondFarPlanePixels;
+    }
+
+    // Wasted draws: reached the z-buffer, visible nowhere in the reference.
+    std::vector<uint8_t> drawn(nt, 0);
+    std::vector<uint8_t> objectDrawn(scene.objects.size(), 0), objectVisible(scene.objects.size(), 0);
+    for (uint32_t t : drawnTriangles) {
+        if (t >= nt || drawn[t] || scene.triangleObject[t] == kExcludedTriangle) continue;
+        drawn[t] = 1;
+        ++a.drawnTriangles;
+        objectDrawn[scene.triangleObject[t]] = 1;
+        const uint64_t f = fragmentsPerSource && t < fragmentsPerSource->size() ? (*fragmentsPerSource)[t] : 0;
+        a.drawnFragments += f;
+        if (ref.pixelsOf[t] == 0) {
+            ++a.wastedTriangles;
+            a.wastedFragments += f;
+        }
+    }
+    for (size_t t = 0; t < nt; ++t)
+        if (ref.pixelsOf[t]) objectVisible[scene.triangleObject[t]] = 1;
+    for (size_t o = 0; o < scene.objects.size(); ++o) {
+        a.drawnObjects += objectDrawn[o];
+        a.wastedObjects += objectDrawn[o] && !objectVisible[o];
+    }
+
+    // Per-pixel fate of the reference's triangle (what reached the z-buffer shows as drawn even if
+    // a stage also listed it: the z-buffer drew it).
+    a.width = ref.width;
+    a.height = ref.height;
+    a.fate.assign(ref.id.size(), kFateBackground);
+    for (size_t i = 0; i < ref.id.size(); ++i) {
+        const uint32_t id = ref.id[i];
+        if (!id) continue;
+        const uint32_t t = id - 1;
+        if (drawn[t]) a.fate[i] = kFateDrawn;
+        else if (culledBy[t] && isSnapped(t, culledBy[t] - 1)) a.fate[i] = kFateSnapped;
+        else if (culledBy[t] && !beyond.empty() && beyond[i]) a.fate[i] = kFateBeyondFarPlane;
+        else if (culledBy[t]) a.fate[i] = uint8_t(kFateCulledFirst + culledBy[t] - 1);
+        else {
+            a.fate[i] = kFateUnaccounted;
+            ++a.unaccountedPixels;
+        }
+    }
+    a.ms = t0.ms();
+    return a;
+}
+
+// ---- Z-buffer against ray casting ---------------------------------------------------------------
+
+EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t, double px, double py) {
+    const ViewTriangle v = viewTriangle(scene, cam, rayOrigin, t);
+    EdgeDistance out;
+    // Orientation sign so that inside is positive: perspective, the sign of det[P0, P1, P2] (the
+    // edge function of edge 01 at the ray towards P2 is det); orthographic, minus the sign of the
+    // 2D area (the edge function below is -cross2). Zero: the triangle is seen edge-on, covers no
+    // area, and every point of it is on its boundary.
+    double sigma;
+    if (cam.orthographic) {
+        const double a2 = (v.P[1].x - v.P[0].x) * (v.P[2].y - v.P[0].y) - (v.P[1].y - v.P[0].y) * (v.P[2].x - v.P[0].x);
+        sigma = a2 > 0 ? -1 : (a2 < 0 ? 1 : 0);
+    } else {
+        const double det = dot(v.P[0], cross(v.P[1], v.P[2]));
+        sigma = det > 0 ? 1 : (det < 0 ? -1 : 0);
+    }
+    if (sigma == 0 || !v.plane.valid) {
+        out.nearEdge = true;
+        out.tolerancePx = kSnapEdgeTolerancePx;
+        return out;
+    }
+
+    // Edge i -> j as a function of the pixel: f(p) = ((Pi - O(p)) x (Pj - O(p))) . D(p), with the
+    // ray O + t D through p (camera.h: perspective O = 0, D affine in p; orthographic O affine in
+    // p, D = -z). f is zero where the ray meets the line through the edge (perspective: the ray
+    // lies in the plane through the eye and the edge, so no vertex is projected and vertices
+    // behind the eye need no care), and affine in p, so its gradient is an exact difference and
+    // f / |grad f| is the signed distance in pixels to the projected edge.
+    auto edgeF = [&](int i, int j, double x, double y) {
+        const ViewRay r = viewRayThroughPixel(cam, x, y);
+        return dot(cross(v.P[i] - r.origin, v.P[j] - r.origin), r.direction);
+    };
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const double dl = length(r.direction);
+    double minS = std::numeric_limits<double>::infinity(), minTol = kSnapEdgeTolerancePx;
+    bool allAbove = true;  // every constraint >= -tolerance
+    bool anyWithin = false;
+    auto take = [&](double s, double tol) {
+        if (s < -tol) allAbove = false;
+        if (s <= tol) anyWithin = true;
+        if (s < minS) {
+            minS = s;
+            minTol = tol;
+        }
+    };
+    for (int k = 0; k < 3; ++k) {
+        const int i = k, j = (k + 1) % 3;
+        const double f = edgeF(i, j, px, py);
+        const double gx = edgeF(i, j, px + 1, py) - f, gy = edgeF(i, j, px, py + 1) - f;
+        const double g = std::hypot(gx, gy);
+        const double qi = length(v.P[i] - r.origin), qj = length(v.P[j] - r.origin);
+        // The float ray caster's uncertainty of f (audit.h, kEmbreeEdgeOps).
+        const double df =
+            (gammaF(kEmbreeEdgeOps) * qi * qj + std::sqrt(3.0) * kFloatU * (v.M[i] * qj + v.M[j] * qi)) * dl;
+        if (g > 0) take(sigma * f / g, kSnapEdgeTolerancePx + df / g);
+        else take(sigma * f > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
+                  kSnapEdgeTolerancePx);
+    }
+
+    // The near and far planes cut the triangle along lines of constant depth: perspective
+    // 1/d = plane(p) (near: 1/near - plane >= 0, far: plane - 1/far >= 0), orthographic d = plane(p).
+    // The z-buffer clips exactly in double and snaps (kSnapEdgeTolerancePx); the ray caster limits
+    // t to [float(near), float(far)] and computes t in float (rayDepthError).
+    const double pv = evalDepthPlane(v.plane, px, py);
+    const double gp = std::hypot(v.plane.a, v.plane.b);
+    const double d = cam.orthographic ? pv : 1 / pv;
+    const double dErr = std::isfinite(d) && d > 0 ? rayDepthError(cam, v, px, py, d) : 0;
+    for (int side = 0; side < 2; ++side) {
+        const double limit = side == 0 ? cam.nearZ : cam.farZ;
+        double s, tolValue;
+        if (cam.orthographic) {
+            s = side == 0 ? pv - limit : limit - pv;
+            tolValue = dErr + kFloatU * limit;
+        } else {
+            s = side == 0 ? 1 / limit - pv : pv - 1 / limit;
+            tolValue = (dErr + kFloatU * limit) / (limit * limit);  // d(1/d) = dd / d^2
+        }
+        if (gp > 0) take(s / gp, kSnapEdgeTolerancePx + tolValue / gp);
+        else take(s >= 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
+                  kSnapEdgeTolerancePx);
+    }
+    out.signedPx = minS;
+    out.tolerancePx = minTol;
+    out.nearEdge = allAbove && anyWithin;
+    return out;
+}
+
+Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin,
+                                  int x, int y, uint32_t idA, uint32_t idB) {
+    if (idA == idB) return Disagreement::none;
+    const double px = x + 0.5, py = y + 0.5;
+    // Edge: who covers this center is decided by rounding, in either method, for either triangle.
+    for (uint32_t id : {idA, idB})
+        if (id && edgeDistance(scene, cam, rayOrigin, id - 1, px, py).nearEdge) return Disagreement::edge;
+    if (!idA || !idB) return Disagreement::genuine;
+    // Tie: both triangles' depths at the center, from their depth planes in double.
+    const ViewTriangle a = viewTriangle(scene, cam, rayOrigin, idA - 1);
+    const ViewTriangle b = viewTriangle(scene, cam, rayOrigin, idB - 1);
+    if (!a.plane.valid || !b.plane.valid) return Disagreement::genuine;
+    const double da = viewDepthAt(cam, a.plane, px, py), db = viewDepthAt(cam, b.plane, px, py);
+    if (depthKey(encoder, da) == depthKey(encoder, db)) return Disagreement::tie;
+    if (std::fabs(da - db) <= rayDepthError(cam, a, px, py, da) + rayDepthError(cam, b, px, py, db))
+        return Disagreement::tie;
+    return Disagreement::genuine;
+}
+
+CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector<double> &zbufferDepth,
+                      const std::vector<uint32_t> &raycastIds, const std::vector<float> &raycastDepth,
+                      const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin) {
+    const Stopwatch t0;
+    CrossCheck c;
+    c.width = cam.width;
+    c.height = cam.height;
+    const size_t n = std::min({zbufferIds.size(), raycastIds.size(), size_t(cam.width) * size_t(cam.height)});
+    c.pixels = n;
+    c.cls.assign(n, uint8_t(Disagreement::none));
+    constexpr size_t kExamples = 16;
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t a = zbufferIds[i], b = raycastIds[i];
+        if (a == b) {
+            ++c.agree;
+            if (a && i < zbufferDepth.size() && i < raycastDepth.size() && zbufferDepth[i] > 0) {
+                const double rel = std::fabs(double(raycastDepth[i]) - zbufferDepth[i]) / zbufferDepth[i];
+                if (std::isfinite(rel)) c.maxRelativeDepthDifference = std::max(c.maxRelativeDepthDifference, rel);
+            }
+            continue;
+        }
+        const int x = int(i % size_t(cam.width)), y = int(i / size_t(cam.width));
+        const Disagreement k = classifyDisagreement(scene, cam, encoder, rayOrigin, x, y, a, b);
+        c.cls[i] = uint8_t(k);
+        if (!a || !b) ++c.oneSidedBackground;
+        switch (k) {
+        case Disagreement::edge: ++c.edge; break;
+        case Disagreement::tie: ++c.tie; break;
+        case Disagreement::genuine:
+            ++c.genuine;
+            if (c.genuineExamples.size() < kExamples) c.genuineExamples.push_back({x, y, a, b});
+            break;
+        case Disagreement::none: break;
+        }
+    }
+    c.ms = t0.ms();
+    return c;
+}
+
+}  // namespace va

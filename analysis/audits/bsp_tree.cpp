@@ -1,0 +1,429 @@
+// The BSP tree (bsp_tree.h; docs/ordering.md). The only translation unit of the ordering work
+// that includes CGAL: everything else asks orient3d().
+#include "analysis/audits/bsp_tree.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "render/stopwatch.h"
+
+namespace va {
+
+namespace {
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+constexpr uint32_t kInputVertex = std::numeric_limits<uint32_t>::max();
+
+K::Point_3 P(Vec3 v) { return K::Point_3(v.x, v.y, v.z); }
+
+// Side of a piece with respect to a plane.
+enum Side : uint8_t { kCoplanar, kFront, kBack, kStraddle };
+
+struct Builder {
+    const Scene &scene;
+    const BspSettings &settings;
+    BspTree &tree;
+    std::vector<uint32_t> vertexTag;  // per tree vertex: the node whose split made it, or kInputVertex
+    uint64_t predicates = 0;
+
+    Vec3 sourceVertex(uint32_t s, int i) const { return scene.positions[scene.indices[3 * size_t(s) + i]]; }
+
+    // Exact side of tree vertex v against the plane of source triangle s used at node `node`:
+    // a vertex made by that node's split is on it by construction.
+    int vertexSide(uint32_t v, uint32_t s, uint32_t node, const Vec3 abc[3]) {
+        if (vertexTag[v] == node) return 0;
+        ++predicates;
+        return orient3d(abc[0], abc[1], abc[2], tree.vertices[v]);
+    }
+
+    // Classifies piece p against the plane of source s (node `node`), sides per vertex into `sides`.
+    Side classify(uint32_t p, uint32_t s, uint32_t node, const Vec3 abc[3], int *sides) {
+        const BspPiece &pc = tree.pieces[p];
+        if (pc.source == s) return kCoplanar;
+        // A split piece: coplanarity is decided on its source's input vertices (exact), not on its
+        // constructed ones (rounded).
+        if (pc.constraintCount) {
+            bool allOn = true;
+            for (int i = 0; i < 3 && allOn; ++i) {
+                ++predicates;
+                allOn = orient3d(abc[0], abc[1], abc[2], sourceVertex(pc.source, i)) == 0;
+            }
+            if (allOn) return kCoplanar;
+        }
+        bool front = false, back = false;
+        for (uint32_t i = 0; i < pc.vertexCount; ++i) {
+            const int sd = vertexSide(pc.firstVertex + i, s, node, abc);
+            if (sides) sides[i] = sd;
+            front |= sd > 0;
+            back |= sd < 0;
+        }
+        if (front && back) return kStraddle;
+        if (front) return kFront;
+        if (back) return kBack;
+        return kCoplanar;
+    }
+
+    // The point where segment a-b crosses the plane (n, through q), in double, computed from the
+    // lexicographically smaller endpoint so that two pieces sharing the edge get the same point.
+    static Vec3 crossing(Vec3 a, Vec3 b, Vec3 n, Vec3 q) {
+        const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
+        if (swap) std::swap(a, b);
+        const double da = dot(n, a - q), db = dot(n, b - q);
+        const double den = da - db;
+        // The exact predicate says a and b lie strictly on opposite sides; in double da, db may
+        // round towards zero, so t is clamped into [0, 1].
+        double t = den != 0 ? da / den : 0.5;
+        t = std::clamp(t, 0.0, 1.0);
+        return a + (b - a) * t;
+    }
+
+    // Splits piece p (straddling, vertex sides given) by node `node`'s plane into a front and a back
+    // piece, appended to tree.pieces; returns their indices.
+    std::pair<uint32_t, uint32_t> split(uint32_t p, uint32_t node, const Vec3 abc[3], const int *sides) {
+        const BspPiece pc = tree.pieces[p];
+        const Vec3 n = cross(abc[1] - abc[0], abc[2] - abc[0]);
+        std::vector<uint32_t> fv, bv;
+        for (uint32_t i = 0; i < pc.vertexCount; ++i) {
+            const uint32_t j = (i + 1) % pc.vertexCount;
+            const uint32_t vi = pc.firstVertex + i, vj = pc.firstVertex + j;
+            if (sides[i] >= 0) fv.push_back(vi);
+            if (sides[i] <= 0) bv.push_back(vi);
+            if (sides[i] * sides[j] < 0) {
+                const Vec3 x = crossing(tree.vertices[vi], tree.vertices[vj], n, abc[0]);
+                const uint32_t nv = uint32_t(tree.vertices.size());
+                tree.vertices.push_back(x);
+                vertexTag.push_back(node);
+                fv.push_back(nv);
+                bv.push_back(nv);
+            }
+        }
+        auto make = [&](const std::vector<uint32_t> &vs, bool front) {
+            BspPiece q;
+            q.source = pc.source;
+            // Copy the vertex run so a piece's vertices stay contiguous (the originals stay shared
+            // by value: same doubles, same tags).
+            q.firstVertex = uint32_t(tree.vertices.size());
+            q.vertexCount = uint32_t(vs.size());
+            for (uint32_t v : vs) {
+                tree.vertices.push_back(tree.vertices[v]);
+                vertexTag.push_back(vertexTag[v]);
+            }
+            q.firstConstraint = uint32_t(tree.constraints.size());
+            q.constraintCount = pc.constraintCount + 1;
+            for (uint32_t c = 0; c < pc.constraintCount; ++c)
+                tree.constraints.push_back(tree.constraints[pc.firstConstraint + c]);
+            tree.constraints.push_back({node, front});
+            tree.pieces.push_back(q);
+            return uint32_t(tree.pieces.size() - 1);
+        };
+        const uint32_t f = make(fv, true);
+        const uint32_t b = make(bv, false);
+        return {f, b};
+    }
+
+    void source3(uint32_t s, Vec3 abc[3]) const {
+        for (int i = 0; i < 3; ++i) abc[i] = sourceVertex(s, i);
+    }
+
+    // Picks the splitter for a node's pieces: `candidates` pieces evenly spread over the list, each
+    // scored over at most `scoreSample` pieces, also evenly spread (all of them for small nodes):
+    // the score estimates the split count and the imbalance at a bounded cost per node.
+    uint32_t chooseSplitter(const std::vector<uint32_t> &list, uint32_t node) {
+        const size_t n = list.size();
+        const size_t k = settings.candidates == 0 ? n : std::min<size_t>(settings.candidates, n);
+        if (k <= 1) return list[0];
+        const size_t m = settings.scoreSample == 0 ? n : std::min<size_t>(settings.scoreSample, n);
+        double best = std::numeric_limits<double>::infinity();
+        uint32_t bestPiece = list[0];
+        for (size_t c = 0; c < k; ++c) {
+            const uint32_t cand = list[(c * n) / k];
+            Vec3 abc[3];
+            source3(tree.pieces[cand].source, abc);
+            uint64_t front = 0, back = 0, splits = 0;
+            for (size_t j = 0; j < m; ++j) {
+                switch (classify(list[(j * n) / m], tree.pieces[cand].source, node, abc, nullptr)) {
+                    case kFront: ++front; break;
+                    case kBack: ++back; break;
+                    case kStraddle: ++splits; ++front; ++back; break;
+                    default: break;
+                }
+            }
+            const double score = settings.splitWeight * double(splits) +
+                                 settings.balanceWeight * std::fabs(double(front) - double(back));
+            if (score < best) {
+                best = score;
+                bestPiece = cand;
+            }
+        }
+        return bestPiece;
+    }
+
+    void build(std::vector<uint32_t> rootList) {
+        // A node to build: its pieces, its parent (by index: `nodes` reallocates) and which child.
+        struct Work {
+            int32_t parent;       // -1 for the root
+            bool frontChild;
+            std::vector<uint32_t> list;
+            uint32_t depth;
+        };
+        std::vector<Work> stack;
+        if (rootList.empty()) return;
+        stack.push_back({-1, false, std::move(rootList), 1});
+        uint64_t leafDepthSum = 0, leaves = 0;
+        std::vector<int> sides;
+        while (!stack.empty()) {
+            Work w = std::move(stack.back());
+            stack.pop_back();
+            const uint32_t node = uint32_t(tree.nodes.size());
+            tree.nodes.push_back({});
+            if (w.parent >= 0) {
+                BspTreeNode &par = tree.nodes[size_t(w.parent)];
+                (w.frontChild ? par.front : par.back) = int32_t(node);
+            }
+            tree.stats.depth = std::max(tree.stats.depth, w.depth);
+
+            const uint32_t splitter = chooseSplitter(w.list, node);
+            const uint32_t s = tree.pieces[splitter].source;
+            Vec3 abc[3];
+            source3(s, abc);
+            tree.nodes[node].planeSource = s;
+            tree.nodes[node].firstPiece = uint32_t(tree.nodePieces.size());
+            std::vector<uint32_t> front, back;
+            for (uint32_t p : w.list) {
+                sides.assign(tree.pieces[p].vertexCount, 0);
+                switch (classify(p, s, node, abc, sides.data())) {
+                    case kCoplanar: tree.nodePieces.push_back(p); break;
+                    case kFront: front.push_back(p); break;
+                    case kBack: back.push_back(p); break;
+                    case kStraddle: {
+                        const auto [f, b] = split(p, node, abc, sides.data());
+                        ++tree.stats.splits;
+                        front.push_back(f);
+                        back.push_back(b);
+                        break;
+                    }
+                }
+            }
+            tree.nodes[node].pieceCount = uint32_t(tree.nodePieces.size()) - tree.nodes[node].firstPiece;
+            if (front.empty() && back.empty()) {
+                leafDepthSum += w.depth;
+                ++leaves;
+            }
+            if (!back.empty()) stack.push_back({int32_t(node), false, std::move(back), w.depth + 1});
+            if (!front.empty()) stack.push_back({int32_t(node), true, std::move(front), w.depth + 1});
+        }
+        tree.stats.averageLeafDepth = leaves ? double(leafDepthSum) / double(leaves) : 0;
+    }
+};
+
+double area2(const BspTree &t, const BspPiece &p) {
+    // Twice the area of the convex polygon (fan from vertex 0), in double.
+    Vec3 sum{};
+    const Vec3 o = t.vertices[p.firstVertex];
+    for (uint32_t i = 1; i + 1 < p.vertexCount; ++i)
+        sum = sum + cross(t.vertices[p.firstVertex + i] - o, t.vertices[p.firstVertex + i + 1] - o);
+    return length(sum);
+}
+
+}  // namespace
+
+namespace {
+
+// Whether the rounded difference x = fl(h - l) is exact: Knuth's TwoSum error of x + l, which is
+// exact (no overflow at level magnitudes), is 0 and x + l == h (Shewchuk's Two_Diff_Tail).
+bool differenceIsExact(double h, double l, double x) {
+    const double bvirt = h - x, avirt = x + bvirt;
+    const double bround = bvirt - l, around = h - avirt;
+    return around + bround == 0;
+}
+
+// The exponent of the lowest set bit of finite nonzero v's significand: v = m 2^k with m odd.
+int lowestBitExponent(double v) {
+    int k;
+    const double m = std::frexp(v, &k);                   // v = m 2^k, 0.5 <= |m| < 1
+    const uint64_t bits = uint64_t(std::fabs(std::ldexp(m, 53)));  // 53-bit integer significand
+    return k - 53 + std::countr_zero(bits);
+}
+
+}  // namespace
+
+int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    // Static filter first (Shewchuk's orient3d, stage A): with the three rows as rounded
+    // differences r1 = b - a, r2 = c - a, r3 = d - a, the double determinant r1 . (r2 x r3) is
+    // within (7 + 56 eps) eps * permanent of the exact one, eps = 2^-53, permanent = the same
+    // expansion with every product in absolute value (the bound covers the rounded differences).
+    // Only when the sign is not certain does CGAL's filtered exact predicate decide.
+    const double r1x = b.x - a.x, r1y = b.y - a.y, r1z = b.z - a.z;
+    const double r2x = c.x - a.x, r2y = c.y - a.y, r2z = c.z - a.z;
+    const double r3x = d.x - a.x, r3y = d.y - a.y, r3z = d.z - a.z;
+    const double m1 = r2y * r3z, m2 = r2z * r3y, m3 = r2z * r3x, m4 = r2x * r3z, m5 = r2x * r3y, m6 = r2y * r3x;
+    const double det = r1x * (m1 - m2) + r1y * (m3 - m4) + r1z * (m5 - m6);
+    const double permanent = std::fabs(r1x) * (std::fabs(m1) + std::fabs(m2)) +
+                             std::fabs(r1y) * (std::fabs(m3) + std::fabs(m4)) +
+                             std::fabs(r1z) * (std::fabs(m5) + std::fabs(m6));
+    constexpr double eps = 0x1p-53;
+    const double bound = (7.0 + 56.0 * eps) * eps * permanent;
+    if (det > bound) return 1;
+    if (det < -bound) return -1;
+    // Exact zeros the filter cannot see (its bound is 0 or the terms cancel), common in levels:
+    // d equal to a corner, and every term of the expansion holding a factor that is exactly zero
+    // (a difference of doubles is 0 only when they are equal, so the exact difference is 0 too),
+    // as for four points on one axis-aligned plane. Then the exact determinant is 0.
+    if (d == a || d == b || d == c) return 0;
+    const bool z1 = r2y == 0 || r3z == 0, z2 = r2z == 0 || r3y == 0, z3 = r2z == 0 || r3x == 0,
+               z4 = r2x == 0 || r3z == 0, z5 = r2x == 0 || r3y == 0, z6 = r2y == 0 || r3x == 0;
+    if ((r1x == 0 || (z1 && z2)) && (r1y == 0 || (z3 && z4)) && (r1z == 0 || (z5 && z6))) return 0;
+    // Integer stage: when the nine differences are exact and are integer multiples of one power of
+    // two 2^e with quotients below 2^40 in magnitude -- as level coordinates on a grid, or floats of
+    // similar size, are -- the determinant of the quotients is exact in 128-bit integers (products
+    // of three below 2^120, six of them below 2^123), and its sign is the sign sought.
+    {
+        const double r[9] = {r1x, r1y, r1z, r2x, r2y, r2z, r3x, r3y, r3z};
+        const double hi[9] = {b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+        const double lo[3] = {a.x, a.y, a.z};
+        bool exact = true;
+        int e = INT32_MAX;
+        for (int i = 0; i < 9 && exact; ++i) {
+            exact = differenceIsExact(hi[i], lo[i % 3], r[i]);
+            if (r[i] != 0) e = std::min(e, lowestBitExponent(r[i]));
+        }
+        if (exact) {
+            __int128 q[9];
+            for (int i = 0; i < 9 && exact; ++i) {
+                const double v = std::ldexp(r[i], -e);  // an integer: exact (a power-of-two scale)
+                exact = std::fabs(v) < 0x1p40;
+                q[i] = exact ? __int128(int64_t(v)) : 0;
+            }
+            if (exact) {
+                const __int128 det128 = q[0] * (q[4] * q[8] - q[5] * q[7]) + q[1] * (q[5] * q[6] - q[3] * q[8]) +
+                                        q[2] * (q[3] * q[7] - q[4] * q[6]);
+                return det128 > 0 ? 1 : (det128 < 0 ? -1 : 0);
+            }
+        }
+    }
+    // CGAL::orientation(p, q, r, s) is the sign of det[q - p, r - p, s - p] (POSITIVE when s is on
+    // the side the counter-clockwise normal of (p, q, r) points to; tested in BspTree.Orient3d*).
+    const CGAL::Orientation o = CGAL::orientation(P(a), P(b), P(c), P(d));
+    return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+}
+
+BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles, const BspSettings &settings) {
+    const Stopwatch t0;
+    BspTree tree;
+    Builder b{scene, settings, tree, {}, 0};
+    std::vector<uint32_t> list;
+    list.reserve(triangles.size());
+    for (uint32_t t : triangles) {
+        BspPiece p;
+        p.source = t;
+        p.firstVertex = uint32_t(tree.vertices.size());
+        p.vertexCount = 3;
+        for (int i = 0; i < 3; ++i) {
+            tree.vertices.push_back(scene.positions[scene.indices[3 * size_t(t) + i]]);
+            b.vertexTag.push_back(kInputVertex);
+        }
+        list.push_back(uint32_t(tree.pieces.size()));
+        tree.pieces.push_back(p);
+    }
+    b.build(std::move(list));
+
+    // Stats: the pieces that ended in nodes are the tree's pieces (split parents are not).
+    BspStats &st = tree.stats;
+    st.trianglesIn = triangles.size();
+    st.nodes = tree.nodes.size();
+    st.pieces = tree.nodePieces.size();
+    std::vector<uint8_t> splitSource(scene.triangleCount(), 0);
+    for (uint32_t p : tree.nodePieces) {
+        const BspPiece &pc = tree.pieces[p];
+        st.trianglesOut += pc.vertexCount - 2;
+        if (pc.constraintCount) {
+            splitSource[pc.source] = 1;
+            if (area2(tree, pc) == 0) ++st.degeneratePieces;
+        }
+    }
+    for (uint8_t s : splitSource) st.splitSources += s;
+    st.predicateCalls = b.predicates;
+    st.memoryBytes = tree.nodes.size() * sizeof(BspTreeNode) + tree.pieces.size() * sizeof(BspPiece) +
+                     tree.nodePieces.size() * sizeof(uint32_t) + tree.vertices.size() * sizeof(Vec3) +
+                     tree.constraints.size() * sizeof(BspConstraint);
+    st.buildMs = t0.ms();
+    return tree;
+}
+
+BspTree buildBspTree(const Scene &scene, const BspSettings &settings) {
+    std::vector<uint32_t> all;
+    all.reserve(scene.triangleCount());
+    for (uint32_t t = 0; t < scene.triangleCount(); ++t)
+        if (scene.triangleObject[t] != kExcludedTriangle) all.push_back(t);
+    return buildBspTree(scene, all, settings);
+}
+
+std::vector<uint32_t> bspBackToFront(const BspTree &tree, const Scene &scene, const Camera &cam) {
+    std::vector<uint32_t> order;
+    order.reserve(tree.nodePieces.size());
+    if (tree.nodes.empty()) return order;
+    // Explicit stack of (node, stage): stage 0 = first visit, 1 = far side done (emit the node's
+    // pieces, then the near side).
+    struct Item {
+        int32_t node;
+        int stage;
+        bool eyeFront;
+    };
+    std::vector<Item> stack{{0, 0, false}};
+    while (!stack.empty()) {
+        Item it = stack.back();
+        stack.pop_back();
+        const BspTreeNode &n = tree.nodes[size_t(it.node)];
+        if (it.stage == 0) {
+            const uint32_t s = n.planeSource;
+            const Vec3 a = scene.positions[scene.indices[3 * size_t(s)]];
+            const Vec3 b = scene.positions[scene.indices[3 * size_t(s) + 1]];
+            const Vec3 c = scene.positions[scene.indices[3 * size_t(s) + 2]];
+            int side;
+            if (cam.orthographic) {
+                // The eye at infinity behind the view direction: the front side faces it when the
+                // plane's normal points against the view direction (edge-on: either order is right).
+                const double v = -dot(cross(b - a, c - a), cam.forward);
+                side = v > 0 ? 1 : (v < 0 ? -1 : 0);
+            } else {
+                side = orient3d(a, b, c, cam.eye);
+            }
+            // Eye in front (or on the plane: the two sides then project to disjoint regions):
+            // the back side is far.
+            const bool eyeFront = side >= 0;
+            const int32_t far = eyeFront ? n.back : n.front;
+            stack.push_back({it.node, 1, eyeFront});
+            if (far >= 0) stack.push_back({far, 0, false});
+        } else {
+            for (uint32_t i = 0; i < n.pieceCount; ++i) order.push_back(tree.nodePieces[n.firstPiece + i]);
+            const int32_t nearChild = it.eyeFront ? n.front : n.back;
+            if (nearChild >= 0) stack.push_back({nearChild, 0, false});
+        }
+    }
+    return order;
+}
+
+BspViewPlanes bspViewPlanes(const BspTree &tree, const Scene &scene, const Camera &cam) {
+    // World plane n.p_w + k = 0 through the source's vertex v0, n = (v1 - v0) x (v2 - v0). With
+    // p_w = eye + x right + y up - z forward (viewFromWorld's rows are right, up, -forward):
+    //   n.p_w + k = (n.right) x + (n.up) y - (n.forward) z + n.(eye - v0).
+    BspViewPlanes vp;
+    vp.plane.resize(4 * tree.nodes.size());
+    for (size_t i = 0; i < tree.nodes.size(); ++i) {
+        const uint32_t s = tree.nodes[i].planeSource;
+        const Vec3 a = scene.positions[scene.indices[3 * size_t(s)]];
+        const Vec3 b = scene.positions[scene.indices[3 * size_t(s) + 1]];
+        const Vec3 c = scene.positions[scene.indices[3 * size_t(s) + 2]];
+        const Vec3 n = cross(b - a, c - a);
+        vp.plane[4 * i + 0] = dot(n, cam.right);
+        vp.plane[4 * i + 1] = dot(n, cam.up);
+        vp.plane[4 * i + 2] = -dot(n, cam.forward);
+        vp.plane[4 * i + 3] = dot(n, cam.eye - a);
+    }
+    return vp;
+}
+
+}  // namespace va

@@ -1,0 +1,789 @@
+// Draw order and exact order (ordering.h; docs/ordering.md).
+#include "analysis/audits/ordering.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+#include <CGAL/box_intersection_d.h>
+
+#include "render/clip.h"
+#include "render/raster_core.h"
+#include "render/stopwatch.h"
+
+namespace va {
+
+namespace {
+
+Vec3 vertexOf(const Scene &s, uint32_t t, int i) { return s.positions[s.indices[3 * size_t(t) + i]]; }
+
+// View depth d = -z_view of a world point (perspective and orthographic alike).
+double viewDepth(const Camera &cam, Vec3 p) { return dot(p - cam.eye, cam.forward); }
+
+const DepthPlane &planeOfSource(const OrderingView &v, uint32_t s) { return v.all.planes[v.all.plane[v.screenBegin[s]]]; }
+
+// Signed area (twice, fixed point) of screen triangle t: < 0 is the front winding (raster_core.h).
+int64_t screenArea(const ScreenTriangles &st, size_t t) {
+    const int32_t *p = st.xy.data() + 6 * t;
+    return (int64_t(p[2]) - p[0]) * (int64_t(p[5]) - p[1]) - (int64_t(p[3]) - p[1]) * (int64_t(p[4]) - p[0]);
+}
+
+// The surface point at pixel (x, y)'s center at view depth d, origin + direction * d of
+// viewRayThroughPixel(x + 0.5, y + 0.5) component by component (the same IEEE operations, so the
+// same bits), with the ray's x parts per column and y parts per row computed once per view
+// instead of two divisions per fragment.
+struct PixelRays {
+    std::vector<double> ox, dx, oy, dy;
+    double oz = 0, dz = 0;
+    size_t width = 0;
+
+    explicit PixelRays(const Camera &cam) {
+        const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
+        width = size_t(W);
+        ox.resize(size_t(W)), dx.resize(size_t(W)), oy.resize(size_t(H)), dy.resize(size_t(H));
+        for (int x = 0; x < W; ++x) {
+            const ViewRay r = viewRayThroughPixel(cam, double(x) + 0.5, 0.5);
+            ox[size_t(x)] = r.origin.x, dx[size_t(x)] = r.direction.x;
+            oz = r.origin.z, dz = r.direction.z;
+        }
+        for (int y = 0; y < H; ++y) {
+            const ViewRay r = viewRayThroughPixel(cam, 0.5, double(y) + 0.5);
+            oy[size_t(y)] = r.origin.y, dy[size_t(y)] = r.direction.y;
+        }
+    }
+    Vec3 point(size_t pixel, double d) const {
+        const size_t x = pixel % width, y = pixel / width;
+        return {ox[x] + dx[x] * d, oy[y] + dy[y] * d, oz + dz * d};
+    }
+};
+
+// The drawing sink: optional depth test (LESS on the double depth), optional piece filter.
+struct OrderSink {
+    const OrderingView &v;
+    const PixelRays &rays;
+    const std::vector<uint32_t> &itemOf;  // per screen triangle of the draw list: its item
+    const std::vector<DrawItem> &items;
+    const BspTree *tree;
+    const BspViewPlanes *planes;
+    bool depthTest;
+    std::vector<double> &depth;
+    std::vector<uint32_t> &id;
+    uint32_t current = 0;
+    uint32_t piece = UINT32_MAX;
+    uint64_t fragments = 0, passes = 0;
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        const DrawItem &it = items[itemOf[t]];
+        if (v.singleSided[it.source] && !frontWinding) return false;
+        current = it.source + 1;
+        piece = (it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount) ? it.piece : UINT32_MAX;
+        return true;
+    }
+    void fragment(size_t i, size_t, double d) {
+        // The surface point at the pixel center: on the ray through it at view depth d.
+        if (piece != UINT32_MAX && !bspPieceContains(*tree, *planes, piece, rays.point(i, d))) return;
+        ++fragments;
+        if (!depthTest) {
+            id[i] = current;
+            ++passes;
+        } else if (d < depth[i]) {
+            depth[i] = d;
+            id[i] = current;
+            ++passes;
+        }
+    }
+    void endTriangle(size_t, uint64_t) {}
+};
+
+}  // namespace
+
+OrderingView prepareOrderingView(const Scene &scene, const Camera &cam, const ReferenceVisibility *ref) {
+    OrderingView v;
+    v.scene = &scene;
+    v.cam = cam;
+    if (ref) {
+        // The reference clipped the same batches with the same settings (referenceVisibility).
+        v.all = ref->screen;
+        if (ref->fragmentCache.complete()) v.fragments = &ref->fragmentCache;
+    } else {
+        std::vector<ClipBatch> batches;
+        for (const SceneObject &o : scene.objects)
+            if (o.triEnd > o.triBegin)
+                batches.push_back(
+                    {o.vertexBegin, o.vertexEnd, scene.objectTriangles.data() + o.triBegin, o.triEnd - o.triBegin});
+        v.all = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, ClipSettings{}).out;
+    }
+    v.screenBegin.assign(scene.triangleCount(), 0);
+    v.screenEnd.assign(scene.triangleCount(), 0);
+    // The clipper emits a source's fan pieces consecutively.
+    for (size_t t = 0; t < v.all.size(); ++t) {
+        const uint32_t s = v.all.source[t];
+        if (v.screenEnd[s] == v.screenBegin[s]) v.screenBegin[s] = uint32_t(t);
+        v.screenEnd[s] = uint32_t(t + 1);
+    }
+    v.singleSided = singleSidedTriangles(scene);
+    return v;
+}
+
+PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
+                                     const std::vector<uint32_t> &ids) {
+    PixelComparison c;
+    c.cls.assign(ids.size(), kOrderRight);
+    const size_t w = size_t(std::max(v.cam.width, 1));
+    for (size_t p = 0; p < ids.size() && p < ref.id.size(); ++p) {
+        const uint32_t a = ids[p], b = ref.id[p];
+        if (a == b) continue;
+        const double px = double(p % w) + 0.5, py = double(p / w) + 0.5;
+        if (a && b &&
+            viewDepthAt(v.cam, planeOfSource(v, a - 1), px, py) == viewDepthAt(v.cam, planeOfSource(v, b - 1), px, py)) {
+            c.cls[p] = kOrderTie;
+            ++c.tiePixels;
+            continue;
+        }
+        // Within the coverage uncertainty of either triangle's boundary (the float frame of the
+        // edge bound at the eye: the rasterizer's snapping dominates).
+        const bool edge = (a && edgeDistance(*v.scene, v.cam, v.cam.eye, a - 1, px, py).nearEdge) ||
+                          (b && edgeDistance(*v.scene, v.cam, v.cam.eye, b - 1, px, py).nearEdge);
+        c.cls[p] = edge ? kOrderEdge : kOrderWrong;
+        (edge ? c.edgePixels : c.wrongPixels)++;
+    }
+    return c;
+}
+
+const char *painterKeyName(PainterKey k) {
+    switch (k) {
+        case PainterKey::centroid: return "centroid";
+        case PainterKey::nearestVertex: return "nearest_vertex";
+        case PainterKey::farthestVertex: return "farthest_vertex";
+    }
+    return "?";
+}
+
+std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
+    const Scene &scene = *v.scene;
+    std::vector<std::pair<double, uint32_t>> keyed;
+    for (uint32_t s = 0; s < scene.triangleCount(); ++s) {
+        if (v.screenEnd[s] == v.screenBegin[s]) continue;
+        const double d0 = viewDepth(v.cam, vertexOf(scene, s, 0)), d1 = viewDepth(v.cam, vertexOf(scene, s, 1)),
+                     d2 = viewDepth(v.cam, vertexOf(scene, s, 2));
+        double k = 0;
+        switch (key) {
+            case PainterKey::centroid: k = (d0 + d1 + d2) / 3; break;  // depth is affine: the centroid's depth
+            case PainterKey::nearestVertex: k = std::min(d0, std::min(d1, d2)); break;
+            case PainterKey::farthestVertex: k = std::max(d0, std::max(d1, d2)); break;
+        }
+        keyed.push_back({k, s});
+    }
+    // Back to front: largest key first; equal keys by descending id, so the lowest id is drawn
+    // last and shows (the reference's tie rule).
+    std::sort(keyed.begin(), keyed.end(), [](const auto &a, const auto &b) {
+        return a.first > b.first || (a.first == b.first && a.second > b.second);
+    });
+    std::vector<uint32_t> order(keyed.size());
+    for (size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
+    return order;
+}
+
+namespace {
+
+// Per drawn item, the indices of its fragments in the view's fragment cache: a whole triangle's
+// are its screen triangles' ranges; a BSP piece's, those of its source whose surface point the
+// piece contains (the test the uncached sink makes per fragment, on the same values).
+struct ItemFragments {
+    std::vector<uint64_t> begin;  // per item, + 1 entry
+    std::vector<uint32_t> index;
+};
+
+// A split source's pieces partition it by the planes of the splits that cut it, and each piece's
+// constraints run from the first split to the last (buildBspTree appends a split's constraint to
+// its parent piece's). So the pieces of one source are the leaves of a binary trie: the first
+// split's plane at the root, the side of it selecting the subtree. A fragment descends it,
+// evaluating each plane on its path once (the expression of bspPieceContains, so the same side),
+// and lands in the one piece whose constraints all hold, or in none -- instead of every piece
+// testing its constraints on every fragment of the source. A source whose pieces do not form such
+// a trie (never from buildBspTree) has its pieces test their fragments directly.
+struct PieceTrie {
+    struct Node {
+        uint32_t plane = UINT32_MAX;  // the BSP node whose plane decides here; UINT32_MAX: a leaf
+        int32_t child[2] = {-1, -1};  // behind, front
+        uint32_t item = UINT32_MAX;   // at a leaf: the draw item (piece) that owns it
+    };
+    std::vector<Node> nodes{Node{}};
+    bool direct = false;
+
+    void insert(const BspTree &tree, uint32_t piece, uint32_t item) {
+        const BspPiece &p = tree.pieces[piece];
+        int32_t at = 0;
+        for (uint32_t i = 0; i < p.constraintCount && !direct; ++i) {
+            const BspConstraint &c = tree.constraints[p.firstConstraint + i];
+            Node &n = nodes[size_t(at)];
+            if (n.item != UINT32_MAX || (n.plane != UINT32_MAX && n.plane != c.node)) {
+                direct = true;
+                return;
+            }
+            n.plane = c.node;
+            const int side = c.front ? 1 : 0;
+            if (nodes[size_t(at)].child[side] < 0) {
+                nodes[size_t(at)].child[side] = int32_t(nodes.size());
+                nodes.push_back(Node{});
+            }
+            at = nodes[size_t(at)].child[side];
+        }
+        Node &leaf = nodes[size_t(at)];
+        if (leaf.plane != UINT32_MAX || leaf.item != UINT32_MAX) direct = true;
+        leaf.item = item;
+    }
+    uint32_t owner(const BspViewPlanes &planes, Vec3 pv) const {
+        int32_t at = 0;
+        while (nodes[size_t(at)].plane != UINT32_MAX) {
+            const double *q = &planes.plane[4 * size_t(nodes[size_t(at)].plane)];
+            const bool front = (q[0] * pv.x + q[1] * pv.y + q[2] * pv.z) + q[3] >= 0;
+            at = nodes[size_t(at)].child[front ? 1 : 0];
+            if (at < 0) return UINT32_MAX;
+        }
+        return nodes[size_t(at)].item;
+    }
+};
+
+// `sel` is filled (its storage reused: the callers keep one per thread, so a view's lists do not
+// fault fresh pages in).
+void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, const BspTree *tree,
+                     const BspViewPlanes *planes, ItemFragments &sel) {
+    const FragmentCache &fc = *v.fragments;
+    const PixelRays rays(v.cam);
+    auto fragmentsOf = [&](uint32_t s) { return std::pair{fc.begin[v.screenBegin[s]], fc.begin[v.screenEnd[s]]}; };
+    auto constrained = [&](const DrawItem &it) { return it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount; };
+
+    // Per split source, the trie of its drawn pieces.
+    std::unordered_map<uint32_t, PieceTrie> tries;
+    for (size_t k = 0; k < items.size(); ++k)
+        if (constrained(items[k])) tries[items[k].source].insert(*tree, items[k].piece, uint32_t(k));
+
+    // Per item its fragment count, then the lists in item order (counting sort: each source's
+    // fragments in ascending order into their owners' slots).
+    // Per cache fragment of a trie source (written before it is read; per-thread storage).
+    thread_local std::vector<uint32_t> owner;
+    if (owner.size() < fc.pixel.size()) owner.resize(fc.pixel.size());
+    std::vector<uint64_t> count(items.size(), 0);
+    std::unordered_map<size_t, std::vector<uint32_t>> directLists;
+    for (auto &[s, trie] : tries) {
+        if (trie.direct) continue;
+        const auto [f0, f1] = fragmentsOf(s);
+        for (uint64_t f = f0; f < f1; ++f) {
+            const uint32_t k = trie.owner(*planes, rays.point(fc.pixel[f], fc.depth[f]));
+            owner[f] = k;
+            if (k != UINT32_MAX) ++count[k];
+        }
+    }
+    for (size_t k = 0; k < items.size(); ++k) {
+        const DrawItem &it = items[k];
+        const auto [f0, f1] = fragmentsOf(it.source);
+        if (!constrained(it)) {
+            count[k] = f1 - f0;
+        } else if (tries.at(it.source).direct) {
+            std::vector<uint32_t> &list = directLists[k];
+            for (uint64_t f = f0; f < f1; ++f)
+                if (bspPieceContains(*tree, *planes, it.piece, rays.point(fc.pixel[f], fc.depth[f])))
+                    list.push_back(uint32_t(f));
+            count[k] = list.size();
+        }
+    }
+    sel.begin.assign(items.size() + 1, 0);
+    for (size_t k = 0; k < items.size(); ++k) sel.begin[k + 1] = sel.begin[k] + count[k];
+    sel.index.resize(sel.begin.back());
+    std::vector<uint64_t> next(sel.begin.begin(), sel.begin.end() - 1);
+    for (size_t k = 0; k < items.size(); ++k) {
+        const DrawItem &it = items[k];
+        const auto [f0, f1] = fragmentsOf(it.source);
+        if (!constrained(it)) {
+            for (uint64_t f = f0; f < f1; ++f) sel.index[next[k]++] = uint32_t(f);
+        } else if (auto d = directLists.find(k); d != directLists.end()) {
+            for (uint32_t f : d->second) sel.index[next[k]++] = f;
+        }
+    }
+    for (auto &[s, trie] : tries) {
+        if (trie.direct) continue;
+        const auto [f0, f1] = fragmentsOf(s);
+        for (uint64_t f = f0; f < f1; ++f)
+            if (owner[f] != UINT32_MAX) sel.index[next[owner[f]]++] = uint32_t(f);
+    }
+}
+
+// The per-pixel results of a draw, and its counts. With the depth test the depth buffer is this
+// thread's scratch buffer, reused from draw to draw and view to view (a fresh 1080p buffer of
+// doubles cost more in page faults than the whole draw), and a pixel counts as covered when its
+// first fragment passes (from +inf: every finite depth passes, and id is never 0 once written);
+// the id buffer is kept only when the caller wants it. Without the depth test every fragment
+// writes, and the ids are needed to count the covered pixels.
+template <bool kDepthTest>
+struct DrawTarget {
+    double *depth = nullptr;
+    std::vector<uint32_t> id;
+    bool keepIds;
+    uint64_t fragments = 0, passes = 0, covered = 0;
+
+    DrawTarget(size_t pixels, bool keepIds_) : keepIds(keepIds_) {
+        if constexpr (kDepthTest) {
+            thread_local std::vector<double> scratch;
+            scratch.assign(pixels, std::numeric_limits<double>::infinity());
+            depth = scratch.data();
+        }
+        if (!kDepthTest || keepIds) id.assign(pixels, 0);
+    }
+    void write(uint32_t pixel, double d, uint32_t current) {
+        ++fragments;
+        if constexpr (!kDepthTest) {
+            id[pixel] = current;
+            ++passes;
+        } else if (d < depth[pixel]) {
+            covered += depth[pixel] == std::numeric_limits<double>::infinity();
+            depth[pixel] = d;
+            if (keepIds) id[pixel] = current;
+            ++passes;
+        }
+    }
+    DrawStats finish(std::vector<uint32_t> *idsOut) {
+        DrawStats st;
+        st.fragments = fragments;
+        st.depthPasses = passes;
+        if constexpr (kDepthTest) {
+            st.coveredPixels = covered;
+        } else {
+            for (uint32_t i : id) st.coveredPixels += i != 0;
+        }
+        st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+        st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+        if (idsOut) *idsOut = std::move(id);
+        return st;
+    }
+};
+
+// A draw from the fragment cache: items in order, each one's fragments by `sel` when given, else
+// its source's screen triangles' ranges. The same fragments in the same item order as the
+// rasterizing draw (within a triangle the order is immaterial: no pixel twice), so the same result.
+template <bool kDepthTest>
+DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, const ItemFragments *sel,
+                     std::vector<uint32_t> *idsOut, bool reverse) {
+    const FragmentCache &fc = *v.fragments;
+    DrawTarget<kDepthTest> target(size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0)),
+                                  idsOut != nullptr);
+    for (size_t j = 0; j < items.size(); ++j) {
+        const size_t k = reverse ? items.size() - 1 - j : j;
+        const uint32_t current = items[k].source + 1;
+        if (sel) {
+            for (uint64_t j = sel->begin[k]; j < sel->begin[k + 1]; ++j) {
+                const uint32_t f = sel->index[j];
+                target.write(fc.pixel[f], fc.depth[f], current);
+            }
+        } else {
+            const uint32_t s = items[k].source;
+            for (uint64_t f = fc.begin[v.screenBegin[s]]; f < fc.begin[v.screenEnd[s]]; ++f)
+                target.write(fc.pixel[f], fc.depth[f], current);
+        }
+    }
+    return target.finish(idsOut);
+}
+
+// The items in order, or (reverse) from the last to the first.
+DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
+                     const ItemFragments *sel, std::vector<uint32_t> *idsOut, bool reverse = false) {
+    return depthTest ? drawCached<true>(v, items, sel, idsOut, reverse)
+                     : drawCached<false>(v, items, sel, idsOut, reverse);
+}
+
+bool hasConstrainedPiece(const std::vector<DrawItem> &items, const BspTree *tree) {
+    for (const DrawItem &it : items)
+        if (it.piece != UINT32_MAX && tree->pieces[it.piece].constraintCount) return true;
+    return false;
+}
+
+}  // namespace
+
+DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest, const BspTree *tree,
+                      const BspViewPlanes *planes, std::vector<uint32_t> *idsOut) {
+    const Stopwatch t0;
+    if (v.fragments) {
+        thread_local ItemFragments sel;
+        const bool pieces = hasConstrainedPiece(items, tree);
+        if (pieces) selectFragments(v, items, tree, planes, sel);
+        DrawStats st = drawCached(v, items, depthTest, pieces ? &sel : nullptr, idsOut);
+        st.ms = t0.ms() + v.fragments->rasterMs;
+        return st;
+    }
+    DrawStats st;
+    // The draw list: each item's screen triangles, in item order (depth planes shared with `all`).
+    ScreenTriangles list;
+    std::vector<uint32_t> itemOf;
+    list.planes = v.all.planes;
+    for (size_t k = 0; k < items.size(); ++k) {
+        const uint32_t s = items[k].source;
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t) {
+            list.xy.insert(list.xy.end(), v.all.xy.begin() + 6 * size_t(t), v.all.xy.begin() + 6 * size_t(t) + 6);
+            list.source.push_back(s);
+            list.plane.push_back(v.all.plane[t]);
+            itemOf.push_back(uint32_t(k));
+        }
+    }
+    const size_t pixels = size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0));
+    std::vector<double> depth(depthTest ? pixels : 0, std::numeric_limits<double>::infinity());
+    std::vector<uint32_t> id(pixels, 0);
+    const PixelRays rays(v.cam);
+    OrderSink sink{v, rays, itemOf, items, tree, planes, depthTest, depth, id};
+    forEachFragment(list, v.cam.width, v.cam.height, v.cam.orthographic, sink);
+    st.fragments = sink.fragments;
+    st.depthPasses = sink.passes;
+    for (uint32_t i : id) st.coveredPixels += i != 0;
+    st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+    st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+    st.ms = t0.ms();
+    if (idsOut) *idsOut = std::move(id);
+    return st;
+}
+
+// ---- Painter's overlap tests --------------------------------------------------------------------
+
+namespace {
+
+struct PairTri {
+    double zmin, zmax;            // view depth range over its clipped screen vertices
+    double bx0, by0, bx1, by1;    // screen bounding rectangle (pixels)
+    uint32_t src, rank;           // rank: position in the painter's order (lower = drawn first)
+};
+
+// Projections disjoint: every screen triangle of a against every one of b separated by one of the
+// six edge normals (integer fixed point, exact in int64: |coordinate| <= 2^29 by the core's range,
+// normals below 2^31, dot products below 2^61). Touching (max == min) counts as separated.
+bool projectionsDisjoint(const ScreenTriangles &st, uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1) {
+    auto separated = [&](const int32_t *A, const int32_t *B) {
+        const int32_t *T[2] = {A, B};
+        for (int w = 0; w < 2; ++w)
+            for (int e = 0; e < 3; ++e) {
+                const int32_t *p = T[w];
+                const int64_t nx = -(int64_t(p[2 * ((e + 1) % 3) + 1]) - p[2 * e + 1]);
+                const int64_t ny = int64_t(p[2 * ((e + 1) % 3)]) - p[2 * e];
+                int64_t minA = INT64_MAX, maxA = INT64_MIN, minB = INT64_MAX, maxB = INT64_MIN;
+                for (int i = 0; i < 3; ++i) {
+                    const int64_t pa = nx * A[2 * i] + ny * A[2 * i + 1], pb = nx * B[2 * i] + ny * B[2 * i + 1];
+                    minA = std::min(minA, pa), maxA = std::max(maxA, pa);
+                    minB = std::min(minB, pb), maxB = std::max(maxB, pb);
+                }
+                if (maxA <= minB || maxB <= minA) return true;
+            }
+        return false;
+    };
+    for (uint32_t a = a0; a < a1; ++a)
+        for (uint32_t b = b0; b < b1; ++b)
+            if (!separated(st.xy.data() + 6 * size_t(a), st.xy.data() + 6 * size_t(b))) return false;
+    return true;
+}
+
+// Every vertex of triangle p on Q's plane or on the side `side` of it (side = +-1: the eye's side,
+// or the side away from it); false when the eye is in Q's plane (side 0).
+bool allOnSide(const Scene &s, uint32_t q, uint32_t p, int side) {
+    if (side == 0) return false;
+    const Vec3 a = vertexOf(s, q, 0), b = vertexOf(s, q, 1), c = vertexOf(s, q, 2);
+    for (int i = 0; i < 3; ++i)
+        if (orient3d(a, b, c, vertexOf(s, p, i)) * side < 0) return false;
+    return true;
+}
+
+int eyeSide(const Scene &s, const Camera &cam, uint32_t q) {
+    const Vec3 a = vertexOf(s, q, 0), b = vertexOf(s, q, 1), c = vertexOf(s, q, 2);
+    if (!cam.orthographic) return orient3d(a, b, c, cam.eye);
+    const double v = -dot(cross(b - a, c - a), cam.forward);
+    return v > 0 ? 1 : (v < 0 ? -1 : 0);
+}
+
+}  // namespace
+
+OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
+    const Stopwatch t0;
+    OverlapTests r;
+    const Scene &scene = *v.scene;
+    const std::vector<uint32_t> order = painterOrder(v, key);
+    std::vector<PairTri> tris;
+    for (uint32_t rank = 0; rank < order.size(); ++rank) {
+        const uint32_t s = order[rank];
+        // Drawn: some screen triangle with nonzero area, and the front winding when single-sided.
+        bool drawn = false;
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t) {
+            const int64_t a = screenArea(v.all, t);
+            drawn = drawn || (a != 0 && (!v.singleSided[s] || a < 0));
+        }
+        if (!drawn) continue;
+        PairTri p{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                  std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                  -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), s, rank};
+        const DepthPlane &pl = planeOfSource(v, s);
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
+            for (int i = 0; i < 3; ++i) {
+                const double px = double(v.all.xy[6 * size_t(t) + 2 * i]) / kSubpixelOne;
+                const double py = double(v.all.xy[6 * size_t(t) + 2 * i + 1]) / kSubpixelOne;
+                const double d = viewDepthAt(v.cam, pl, px, py);
+                p.zmin = std::min(p.zmin, d), p.zmax = std::max(p.zmax, d);
+                p.bx0 = std::min(p.bx0, px), p.bx1 = std::max(p.bx1, px);
+                p.by0 = std::min(p.by0, py), p.by1 = std::max(p.by1, py);
+            }
+        tris.push_back(p);
+    }
+    const size_t n = tris.size();
+    r.trianglesTested = n;
+
+    // Pairs whose closed depth ranges overlap: all pairs minus those with a entirely nearer than b
+    // (a.zmax < b.zmin), counted with a binary search over the sorted zmin.
+    std::vector<double> zmins(n);
+    for (size_t i = 0; i < n; ++i) zmins[i] = tris[i].zmin;
+    std::sort(zmins.begin(), zmins.end());
+    uint64_t disjoint = 0;
+    for (const PairTri &t : tris) disjoint += uint64_t(zmins.end() - std::upper_bound(zmins.begin(), zmins.end(), t.zmax));
+    r.pairs = uint64_t(n) * (n - (n > 0)) / 2 - disjoint;
+
+    // Pairs whose bounding rectangles overlap too: their closed boxes (screen rectangle x depth
+    // range) intersect. CGAL's box intersection (a streaming segment tree, O(n log^3 n + k))
+    // reports each such pair once, in an order that does not matter: each pair's outcome depends on
+    // the pair alone, and the counts are sums.
+    using Box = CGAL::Box_intersection_d::Box_with_handle_d<double, 3, const PairTri *,
+                                                            CGAL::Box_intersection_d::ID_FROM_HANDLE>;
+    std::vector<Box> boxes;
+    boxes.reserve(n);
+    for (const PairTri &t : tris) boxes.emplace_back(CGAL::Bbox_3(t.bx0, t.by0, t.zmin, t.bx1, t.by1, t.zmax), &t);
+    uint64_t boundsOverlap = 0;
+    // The eye's side of each drawn triangle's plane, once per triangle instead of once per pair.
+    std::vector<int8_t> eyeSideOf(scene.triangleCount(), 0);
+    for (const PairTri &t : tris) eyeSideOf[t.src] = int8_t(eyeSide(scene, v.cam, t.src));
+    auto classify = [&](const Box &a, const Box &b) {
+        const PairTri &A = *a.handle(), &B = *b.handle();
+        ++boundsOverlap;
+        const PairTri &Pt = A.rank < B.rank ? A : B;  // drawn first: the farther by the sort
+        const PairTri &Qt = A.rank < B.rank ? B : A;
+        const uint32_t P = Pt.src, Q = Qt.src;
+        const int eyeQ = eyeSideOf[Q], eyeP = eyeSideOf[P];
+        if (allOnSide(scene, Q, P, -eyeQ)) {
+            ++r.behindPlane;
+        } else if (allOnSide(scene, P, Q, eyeP)) {
+            ++r.inFrontOfPlane;
+        } else if (projectionsDisjoint(v.all, v.screenBegin[P], v.screenEnd[P], v.screenBegin[Q], v.screenEnd[Q])) {
+            ++r.projectionsDisjoint;
+        } else if (allOnSide(scene, P, Q, -eyeP)) {  // Newell's swap: Q is the farther one
+            ++r.behindPlane;
+            ++r.swapped;
+        } else if (allOnSide(scene, Q, P, eyeQ)) {
+            ++r.inFrontOfPlane;
+            ++r.swapped;
+        } else {
+            ++r.unresolved;
+        }
+    };
+    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), classify);
+    r.boundsDisjoint = r.pairs - boundsOverlap;
+    r.ms = t0.ms();
+    return r;
+}
+
+PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility &ref, PainterKey key,
+                                bool overlapTests) {
+    PainterResult r;
+    r.key = key;
+    const Stopwatch t0;
+    const std::vector<uint32_t> order = painterOrder(v, key);
+    r.sortMs = t0.ms();
+    std::vector<DrawItem> items(order.size());
+    for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
+    r.trianglesDrawn = order.size();
+    const DrawStats st = drawInOrder(v, items, false, nullptr, nullptr, &r.id);
+    r.drawMs = st.ms;
+    r.fragments = st.fragments;
+    r.coveredPixels = st.coveredPixels;
+    r.overdraw = st.overdraw;
+    PixelComparison c = compareWithReference(v, ref, r.id);
+    r.wrongPixels = c.wrongPixels;
+    r.tiePixels = c.tiePixels;
+    r.edgePixels = c.edgePixels;
+    r.cls = std::move(c.cls);
+    r.memoryBytes = r.id.size() * sizeof(uint32_t) + order.size() * (sizeof(double) + sizeof(uint32_t));
+    if (overlapTests) r.overlaps = painterOverlapTests(v, key);
+    return r;
+}
+
+BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree) {
+    BspViewResult r;
+    const Stopwatch t0;
+    const std::vector<uint32_t> order = bspBackToFront(tree, *v.scene, v.cam);
+    const BspViewPlanes planes = bspViewPlanes(tree, *v.scene, v.cam);
+    r.traverseMs = t0.ms();
+    std::vector<DrawItem> items;
+    items.reserve(order.size());
+    for (uint32_t p : order)
+        if (v.screenEnd[tree.pieces[p].source] > v.screenBegin[tree.pieces[p].source])
+            items.push_back({tree.pieces[p].source, p});
+    r.piecesDrawn = items.size();
+    if (v.fragments) {
+        // Both orders draw the same pieces' fragments: the piece test runs once, and each order's
+        // time is its own pass plus that selection plus the rasterization that recorded them.
+        const Stopwatch ts;
+        thread_local ItemFragments sel;
+        selectFragments(v, items, &tree, &planes, sel);
+        const double selectMs = ts.ms() + v.fragments->rasterMs;
+        const Stopwatch tb;
+        r.backToFront = drawCached(v, items, false, &sel, &r.id);
+        r.backToFront.ms = tb.ms() + selectMs;
+        // Front to back: the same items and lists, from the last to the first.
+        const Stopwatch tf;
+        r.frontToBack = drawCached(v, items, true, &sel, nullptr, true);
+        r.frontToBack.ms = tf.ms() + selectMs;
+    } else {
+        r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
+        std::reverse(items.begin(), items.end());
+        r.frontToBack = drawInOrder(v, items, true, &tree, &planes, nullptr);
+    }
+    PixelComparison c = compareWithReference(v, ref, r.id);
+    r.wrongPixels = c.wrongPixels;
+    r.tiePixels = c.tiePixels;
+    r.edgePixels = c.edgePixels;
+    r.cls = std::move(c.cls);
+    return r;
+}
+
+ABufferResult abufferForView(const OrderingView &v, uint32_t maxListLength) {
+    const Scene &scene = *v.scene;
+    const size_t n = scene.triangleCount();
+    std::vector<float> alpha(n, 1.0f);
+    std::vector<uint8_t> rgb(3 * n, 255);
+    std::vector<uint32_t> surface(n, UINT32_MAX);
+    for (size_t t = 0; t < n; ++t) {
+        const uint32_t o = scene.triangleObject[t];
+        if (o == kExcludedTriangle) continue;
+        const SceneObject &ob = scene.objects[o];
+        surface[t] = ob.source;  // a source object (one mesh, one material) is one surface
+        alpha[t] = float(std::clamp(scene.materials[ob.material].alpha, 0.0, 1.0));
+        // A fixed color per source object: a multiplicative hash of its index, kept bright.
+        const uint32_t h = (ob.source + 1) * 2654435761u;
+        rgb[3 * t + 0] = uint8_t(64 + (h >> 24) % 192);
+        rgb[3 * t + 1] = uint8_t(64 + (h >> 16) % 192);
+        rgb[3 * t + 2] = uint8_t(64 + (h >> 8) % 192);
+    }
+    ABufferMaterials m;
+    m.alpha = alpha.data();
+    m.rgb = rgb.data();
+    m.singleSided = v.singleSided.data();
+    m.surface = surface.data();
+    m.background[0] = m.background[1] = m.background[2] = 24;
+    return resolveABuffer(v.all, v.cam.width, v.cam.height, v.cam.orthographic, m, maxListLength);
+}
+
+OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const ReferenceVisibility &ref,
+                               const BspTree &tree, const EffectDecision &abuffer, const OrderingSettings &settings) {
+    const Stopwatch t0;
+    OrderingResult r;
+    const OrderingView v = prepareOrderingView(scene, cam, &ref);
+    const size_t pixels = size_t(std::max(cam.width, 0)) * size_t(std::max(cam.height, 0));
+
+    r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);
+    r.bsp = bspForView(v, ref, tree);
+    std::vector<uint32_t> submittedIds;
+
+    // Overdraw by draw order, each with the depth test.
+    {
+        std::vector<DrawItem> submitted;
+        for (size_t t = 0; t < v.all.size(); ++t)
+            if (submitted.empty() || submitted.back().source != v.all.source[t]) submitted.push_back({v.all.source[t]});
+        // With the fragment cache this draw is also the z-buffer row below (kept ids).
+        r.overdrawByOrder.push_back(
+            {"submitted", drawInOrder(v, submitted, true, nullptr, nullptr, v.fragments ? &submittedIds : nullptr)});
+
+        std::vector<DrawItem> backToFront;
+        for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
+        r.overdrawByOrder.push_back({"back_to_front", drawInOrder(v, backToFront, true, nullptr, nullptr, nullptr)});
+
+        // Front to back by object: objects by the view depth of their bounding sphere's center
+        // (nearest first, ties by index), triangles of an object in submission order.
+        std::vector<uint32_t> objs(scene.objects.size());
+        std::iota(objs.begin(), objs.end(), 0u);
+        std::vector<double> od(objs.size());
+        for (uint32_t o : objs) od[o] = viewDepth(cam, scene.objects[o].sphere.center);
+        std::stable_sort(objs.begin(), objs.end(), [&](uint32_t a, uint32_t b) { return od[a] < od[b]; });
+        std::vector<DrawItem> frontToBack;
+        for (uint32_t o : objs)
+            for (uint32_t i = scene.objects[o].triBegin; i < scene.objects[o].triEnd; ++i) {
+                const uint32_t s = scene.objectTriangles[i];
+                if (v.screenEnd[s] > v.screenBegin[s]) frontToBack.push_back({s});
+            }
+        r.overdrawByOrder.push_back(
+            {"front_to_back_objects", drawInOrder(v, frontToBack, true, nullptr, nullptr, nullptr)});
+        r.overdrawByOrder.push_back({"bsp_front_to_back", r.bsp.frontToBack});
+    }
+
+    // Scanline.
+    r.scanline = scanlineVisibility(v.all, cam.width, cam.height, cam.orthographic, v.singleSided.data());
+    {
+        const PixelComparison c = compareWithReference(v, ref, r.scanline.id);
+        r.scanlineWrongPixels = c.wrongPixels;
+        r.scanlineTiePixels = c.tiePixels;
+        r.scanlineEdgePixels = c.edgePixels;
+    }
+
+    // The z-buffer as the pipeline's audit runs it (double depth, single-sided, submission order).
+    OrderingRow zrow;
+    zrow.method = "zbuffer";
+    if (v.fragments) {
+        // The z-buffer with exact depth (rasterize's exactDepth: LESS on the double view depth, the
+        // first drawn of equal depths stays) in submission order is the "submitted" draw above:
+        // the same fragments through the same test, so the same ids and passes. Its overdraw
+        // divides by the pixels holding a fragment, as the z-buffer's statistics do.
+        const Stopwatch tz;
+        std::vector<uint8_t> touched(pixels, 0);
+        for (uint32_t p : v.fragments->pixel) touched[p] = 1;
+        uint64_t covered = 0;
+        for (uint8_t t : touched) covered += t;
+        const DrawStats &sub = r.overdrawByOrder[0].stats;
+        zrow.drawMs = sub.ms + tz.ms();
+        const PixelComparison c = compareWithReference(v, ref, submittedIds);
+        zrow.wrongPixels = c.wrongPixels;
+        zrow.tiePixels = c.tiePixels;
+        zrow.edgePixels = c.edgePixels;
+        zrow.overdraw = covered ? double(sub.depthPasses) / double(covered) : 0;
+        zrow.memoryBytes = pixels * (sizeof(uint32_t) + sizeof(double));  // ids and depths
+    } else {
+        ZBufferSettings zs;
+        zs.encoder = makeDepthEncoder(DepthFormat::f32, cam.nearZ, cam.farZ);
+        zs.orthographic = cam.orthographic;
+        zs.exactDepth = true;
+        zs.singleSided = v.singleSided.data();
+        const Stopwatch tz;
+        const ZBufferResult z = rasterize(v.all, cam.width, cam.height, zs);
+        zrow.drawMs = tz.ms();
+        const PixelComparison c = compareWithReference(v, ref, z.buffer.id);
+        zrow.wrongPixels = c.wrongPixels;
+        zrow.tiePixels = c.tiePixels;
+        zrow.edgePixels = c.edgePixels;
+        zrow.overdraw = z.stats.overdraw;
+        zrow.memoryBytes = pixels * (sizeof(uint32_t) + sizeof(double));  // ids and depths
+    }
+
+    OrderingRow painter{"painter",           r.painter.sortMs,      r.painter.drawMs,
+                        r.painter.wrongPixels, r.painter.tiePixels, r.painter.edgePixels,
+                        r.painter.overdraw,    r.painter.memoryBytes};
+    OrderingRow bsp{"bsp",
+                    tree.stats.buildMs,
+                    r.bsp.traverseMs + r.bsp.backToFront.ms,
+                    r.bsp.wrongPixels,
+                    r.bsp.tiePixels,
+                    r.bsp.edgePixels,
+                    r.bsp.backToFront.overdraw,
+                    pixels * sizeof(uint32_t) + tree.stats.memoryBytes};
+    OrderingRow scan{"scanline",         r.scanline.buildMs,     r.scanline.ms,      r.scanlineWrongPixels,
+                     r.scanlineTiePixels, r.scanlineEdgePixels, r.scanline.overdraw, r.scanline.memoryBytes};
+    r.table = {painter, bsp, scan, zrow};
+
+    r.abufferReason = abuffer.reason;
+    if (abuffer.run) {
+        r.abuffer = abufferForView(v, settings.abufferMaxList);
+        r.abufferRan = true;
+    }
+    r.ms = t0.ms();
+    return r;
+}
+
+}  // namespace va

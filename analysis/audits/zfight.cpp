@@ -1,0 +1,583 @@
+// Per-view z-fighting analysis (zfight.h; definitions and rules in docs/zfighting.md).
+//
+// Structure of analyzeZFighting:
+//   1. findTwoNearest: one pass over the z-buffer's fragments (forEachFragment) keeping, per pixel,
+//      the two nearest surfaces from distinct source triangles;
+//   2. per format (dispatched once, so encodeDepth<F> inlines): keys of both depths, fight bit,
+//      out-of-range count;
+//   3. classification of the pixels that fight in at least one format, from a per-triangle-pair
+//      cache (common vertices, shared edge in screen space, coplanarity) and the two depth planes at
+//      the pixel's corners;
+//   4. 8-connected components of the hotspot pixels (separated or coplanar) with their statistics,
+//      sorted into hotspot ids;
+//   5. per-format counts and the recommendation;
+//   6. per listed hotspot, why it fights (explainHotspot).
+#include "analysis/audits/zfight.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <unordered_map>
+
+#include "analysis/audits/depth_audit.h"
+#include "render/depth_format_impl.h"
+#include "render/raster_core.h"
+
+namespace va {
+
+const char *zPixelClassName(ZPixelClass c) {
+    switch (c) {
+    case ZPixelClass::none: return "none";
+    case ZPixelClass::separated: return "separated";
+    case ZPixelClass::coplanar: return "coplanar";
+    case ZPixelClass::shared_edge: return "shared_edge";
+    case ZPixelClass::intersection: return "intersection";
+    }
+    return "none";
+}
+
+const ZFightFormatStats *zfightStatsOf(const ZFightResult &r, const DepthFormatSpec &format) {
+    for (const ZFightFormatStats &s : r.perFormat)
+        if (s.format == format) return &s;
+    return nullptr;
+}
+
+// ---- Pass 1: two nearest surfaces -------------------------------------------------------------
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Keeps per pixel the two nearest fragments of distinct source triangles. Fragments arrive in
+// submission order, so "strictly nearer" comparisons keep the first drawn in front on equal
+// depths, exactly like the z-buffer's LESS test on equal keys.
+struct TwoNearestSink {
+    TwoNearest *out;
+    const uint32_t *source;       // ScreenTriangles::source
+    const uint8_t *singleSided;   // as ZBufferSettings::singleSided (may be null)
+    uint32_t current = 0;         // source triangle of the triangle being walked
+
+    bool beginTriangle(size_t t, bool frontWinding) {
+        current = source[t];
+        // The z-buffer skips single-sided triangles whose projected winding is the back one.
+        return !(singleSided && singleSided[current] && !frontWinding);
+    }
+    void fragment(size_t pixel, size_t t, double d) {
+        double &d1 = out->depth1[pixel], &d2 = out->depth2[pixel];
+        uint32_t &t1 = out->screen1[pixel], &t2 = out->screen2[pixel];
+        // Same surface as a kept one (another clipped piece of the same source triangle): keep the
+        // nearer depth of that surface, never a second slot for it.
+        if (t1 != kNoFragment && source[t1] == current) {
+            if (d < d1) d1 = d, t1 = uint32_t(t);
+            return;
+        }
+        if (t2 != kNoFragment && source[t2] == current) {
+            if (d < d2) {
+                d2 = d, t2 = uint32_t(t);
+                if (d2 < d1) std::swap(d1, d2), std::swap(t1, t2);
+            }
+            return;
+        }
+        if (d < d1) {
+            d2 = d1, t2 = t1;
+            d1 = d, t1 = uint32_t(t);
+        } else if (d < d2) {
+            d2 = d, t2 = uint32_t(t);
+        }
+    }
+    void endTriangle(size_t, uint64_t) {}
+};
+
+}  // namespace
+
+TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic,
+                          const uint8_t *singleSided) {
+    TwoNearest r;
+    r.width = std::max(width, 0);
+    r.height = std::max(height, 0);
+    const size_t n = size_t(r.width) * size_t(r.height);
+    r.depth1.assign(n, kInf);
+    r.depth2.assign(n, kInf);
+    r.screen1.assign(n, kNoFragment);
+    r.screen2.assign(n, kNoFragment);
+    if (n == 0) return r;
+    TwoNearestSink sink{&r, tris.source.data(), singleSided};
+    forEachFragment(tris, r.width, r.height, orthographic, sink);
+    return r;
+}
+
+// ---- Triangle pairs: common vertices, shared edge, coplanarity --------------------------------
+
+namespace {
+
+struct PairInfo {
+    bool coplanar = false;
+    bool sharedEdge = false;       // exactly two common vertex positions
+    bool edgeOnScreen = false;     // the shared edge has a part in front of the near plane
+    double ex0 = 0, ey0 = 0, ex1 = 0, ey1 = 0;  // that part, projected, in pixel coordinates
+};
+
+void triangleVertices(const Scene &scene, uint32_t t, Vec3 v[3]) {
+    for (int k = 0; k < 3; ++k) v[k] = scene.positions[scene.indices[3 * size_t(t) + k]];
+}
+
+// Coplanar up to the precision of the coordinates: every vertex of the smaller triangle lies within
+//   tol = 64 * u * M     (u = 2^-53 the unit roundoff, M = largest |coordinate| of the six vertices)
+// of the larger triangle's plane (the larger one's normal is the better conditioned). A coordinate
+// is stored to within u*M, and the distance n.(p - v0)/|n| is computed with about ten roundings of
+// quantities bounded by M, so exactly coplanar triangles pass with a wide margin; two surfaces that
+// are apart by more than 64 half-ulps of the scene's coordinates (a 1 mm decal at 200 m: 1e-3 vs
+// 1.4e-12) are not coplanar. Scales with the scene as STYLE.md asks where no exact rule exists.
+bool coplanarTriangles(const Vec3 a[3], const Vec3 b[3]) {
+    double M = 0;
+    for (int k = 0; k < 3; ++k) M = std::max({M, maxAbs(a[k]), maxAbs(b[k])});
+    const Vec3 na = cross(a[1] - a[0], a[2] - a[0]), nb = cross(b[1] - b[0], b[2] - b[0]);
+    const bool aLarger = dot(na, na) >= dot(nb, nb);
+    const Vec3 *ref = aLarger ? a : b, *other = aLarger ? b : a;
+    const Vec3 n = aLarger ? na : nb;
+    const double nl = length(n);
+    if (!(nl > 0)) return false;
+    const double tol = 64 * kDoubleEps * M;
+    for (int k = 0; k < 3; ++k)
+        if (!(std::fabs(dot(n, other[k] - ref[0])) / nl <= tol)) return false;
+    return true;
+}
+
+struct PairCache {
+    const Scene &scene;
+    const Camera &cam;
+    std::unordered_map<uint64_t, PairInfo> cache;
+
+    static uint64_t key(uint32_t a, uint32_t b) {
+        if (a > b) std::swap(a, b);
+        return (uint64_t(a) << 32) | b;
+    }
+
+    // Pixel coordinates of a view-space point in front of the eye (the clipper's projection).
+    void project(Vec3 v, double *px, double *py) const {
+        const double w = cam.orthographic ? 1.0 : -v.z;
+        *px = (cam.sx * v.x / w + 1.0) * (cam.width * 0.5);
+        *py = (1.0 - cam.sy * v.y / w) * (cam.height * 0.5);
+    }
+
+    const PairInfo &get(uint32_t a, uint32_t b) {
+        auto [it, inserted] = cache.try_emplace(key(a, b));
+        if (!inserted) return it->second;
+        PairInfo &info = it->second;
+        Vec3 va[3], vb[3];
+        triangleVertices(scene, a, va);
+        triangleVertices(scene, b, vb);
+        info.coplanar = coplanarTriangles(va, vb);
+        // Common vertex positions (exact equality: a closed mesh's neighbours index the same vertex
+        // or a bit-identical copy). Two -> a shared edge; three is a duplicate triangle (coplanar).
+        Vec3 common[3];
+        int nc = 0;
+        for (int i = 0; i < 3; ++i) {
+            bool dup = false;
+            for (int k = 0; k < nc; ++k) dup = dup || common[k] == va[i];
+            if (dup) continue;
+            for (int j = 0; j < 3; ++j)
+                if (va[i] == vb[j]) {
+                    common[nc++] = va[i];
+                    break;
+                }
+        }
+        info.sharedEdge = nc == 2;
+        if (info.sharedEdge) {
+            // The edge in view space, cut to the part in front of the near plane (d >= near) so its
+            // projection is finite, then projected to pixel coordinates.
+            Vec3 p = transformPoint(cam.viewFromWorld, common[0]), q = transformPoint(cam.viewFromWorld, common[1]);
+            const double n = cam.nearZ;
+            const double dp = -p.z, dq = -q.z;
+            bool visible = true;
+            if (!cam.orthographic) {
+                if (dp < n && dq < n) visible = false;
+                else if (dp < n) p = p + (q - p) * ((n - dp) / (dq - dp));
+                else if (dq < n) q = q + (p - q) * ((n - dq) / (dp - dq));
+            }
+            if (visible) {
+                project(p, &info.ex0, &info.ey0);
+                project(q, &info.ex1, &info.ey1);
+                info.edgeOnScreen = std::isfinite(info.ex0) && std::isfinite(info.ey0) && std::isfinite(info.ex1) &&
+                                    std::isfinite(info.ey1);
+            }
+        }
+        return info;
+    }
+};
+
+// Distance from (x, y) to the segment (x0, y0)-(x1, y1).
+double distanceToSegment(double x, double y, double x0, double y0, double x1, double y1) {
+    const double dx = x1 - x0, dy = y1 - y0;
+    const double len2 = dx * dx + dy * dy;
+    double t = len2 > 0 ? ((x - x0) * dx + (y - y0) * dy) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy));
+}
+
+// Does the line where the two depth planes give equal depth cross the pixel's square
+// [x, x+1] x [y, y+1]? Both planes are evaluated at the four corners exactly as the rasterizer
+// evaluates them ((a px + b py) + c); the difference is
+//   Delta = vA - vB,  |error| <= gamma(4) (sA + sB),  s = |a px| + |b py| + |c|
+// (three roundings in each evaluation, one in the subtraction; the coefficients are taken as
+// exact: they are the surfaces the z-buffer draws). A corner whose |Delta| is within the bound is
+// "on the line". Crossing: corners strictly on both sides, or at least one on the line and one
+// strictly off it. All four within the bound: the planes are indistinguishable at this pixel, so
+// there is no line to speak of (not an intersection). Perspective planes hold 1/d, so the sign of
+// Delta is the depth order only where both values are positive: any corner at or behind the eye
+// plane (plane value <= 0) makes the test say no.
+bool planesCrossInPixel(const DepthPlane &A, const DepthPlane &B, int x, int y, bool orthographic) {
+    bool pos = false, neg = false, on = false;
+    for (int c = 0; c < 4; ++c) {
+        const double px = double(x + (c & 1)), py = double(y + (c >> 1));
+        const double vA = evalDepthPlane(A, px, py), vB = evalDepthPlane(B, px, py);
+        if (!orthographic && !(vA > 0 && vB > 0)) return false;
+        if (!std::isfinite(vA) || !std::isfinite(vB)) return false;
+        const double sA = std::fabs(A.a * px) + std::fabs(A.b * py) + std::fabs(A.c);
+        const double sB = std::fabs(B.a * px) + std::fabs(B.b * py) + std::fabs(B.c);
+        const double bound = gamma(4) * (sA + sB);
+        const double delta = vA - vB;
+        if (delta > bound) pos = true;
+        else if (delta < -bound) neg = true;
+        else on = true;
+    }
+    return (pos && neg) || (on && (pos || neg));
+}
+
+// Name of the source object a triangle id belongs to (sources are contiguous in source order).
+std::string sourceObjectName(const Scene &scene, uint32_t tri) {
+    const auto &src = scene.sources;
+    auto it = std::upper_bound(src.begin(), src.end(), tri,
+                               [](uint32_t t, const SourceObject &s) { return t < s.firstTriangle; });
+    if (it == src.begin()) return std::string();
+    --it;
+    return tri < it->firstTriangle + it->triangleCount ? it->name : std::string();
+}
+
+// Median of v (upper median for even sizes, so it is always one of the values); v is reordered.
+double median(std::vector<double> &v) {
+    if (v.empty()) return 0;
+    const size_t m = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + ptrdiff_t(m), v.end());
+    return v[m];
+}
+
+// World-space point of view depth d on the ray through pixel coordinates (px, py).
+Vec3 worldPointAt(const Camera &cam, double px, double py, double d) {
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    // View point o + d * dir (dir.z = -1, so the parameter is the view depth); view axes are
+    // (right, up, -forward) in world space.
+    const Vec3 v = r.origin + r.direction * d;
+    return cam.eye + cam.right * v.x + cam.up * v.y - cam.forward * v.z;
+}
+
+bool validate(const ZFightSettings &s, const Camera &cam, std::string *err) {
+    if (s.formats.empty()) {
+        *err = "no depth formats to evaluate; pass at least one (e.g. all of allDepthFormats())";
+        return false;
+    }
+    if (s.formats.size() > 32) {
+        *err = "at most 32 depth formats can be evaluated at once (the per-pixel fight mask has 32 bits)";
+        return false;
+    }
+    for (size_t i = 0; i < s.formats.size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (s.formats[i] == s.formats[j]) {
+                *err = "depth format '" + depthFormatName(s.formats[i]) + "' is listed twice; list each format once";
+                return false;
+            }
+    for (const DepthFormatSpec &f : s.formats)
+        if (!validateDepthFormatRange(f, cam.nearZ, cam.farZ, err)) return false;
+    if (!(std::isfinite(s.sharedEdgePixels) && s.sharedEdgePixels >= 0)) {
+        *err = "sharedEdgePixels must be a finite distance >= 0 (pixels); the default is 1";
+        return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+// ---- Why a hotspot fights ------------------------------------------------------------------------
+
+void explainHotspot(double nearZ, double farZ, const std::optional<DepthFormatSpec> &viewFormat, bool coplanar,
+                    ZFightHotspot *h) {
+    auto m = [](double v) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.3g m", v);
+        return std::string(b);
+    };
+    h->coplanar = coplanar;
+    h->viewBucketWidth.reset();
+    h->cheapestFormat.reset();
+    h->cheapestBucketWidth.reset();
+    std::string view;
+    if (viewFormat)
+        if (const auto b = depthBucketAt(makeDepthEncoder(*viewFormat, nearZ, farZ), h->depth)) {
+            h->viewBucketWidth = b->width;
+            view = depthFormatName(*viewFormat) + "'s stored-value bucket there is " + m(b->width) + " wide, " +
+                   (b->width > h->depthGap ? "wider than the gap"
+                                            : "no wider than the gap (its fighting pixels lie at other depths or gaps "
+                                              "than these medians)");
+        }
+    if (coplanar) {
+        h->why = "coplanar surfaces: no depth format can order them; offset one surface or use a depth bias";
+        return;
+    }
+    // The cheapest format whose bucket at the hotspot's depth is no wider than the gap: then the
+    // surface the gap behind lies in a later bucket, whatever the position inside this one.
+    for (DepthFormat f : depthFormatsCheapestFirst()) {
+        const auto b = depthBucketAt(makeDepthEncoder(f, nearZ, farZ), h->depth);
+        if (b && b->width <= h->depthGap) {
+            h->cheapestFormat = f;
+            h->cheapestBucketWidth = b->width;
+            break;
+        }
+    }
+    h->why = "surfaces " + m(h->depthGap) + " apart at " + m(h->depth) + (view.empty() ? "" : "; " + view) + "; ";
+    if (h->cheapestFormat)
+        h->why += "the cheapest format that orders them there: " +
+                  std::string(depthFormatInfo(*h->cheapestFormat).name) + " (" +
+                  std::to_string(depthFormatInfo(*h->cheapestFormat).bits) + " bits, bucket " +
+                  m(*h->cheapestBucketWidth) + ")";
+    else
+        h->why += "every format's bucket there is wider than the gap: move the surfaces apart or pull the near "
+                  "plane out";
+}
+
+// ---- The analysis -----------------------------------------------------------------------------
+
+ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const ScreenTriangles &tris,
+                              const ZFightSettings &settings) {
+    ZFightResult r;
+    if (!validate(settings, cam, &r.error)) return r;
+    const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
+    const size_t N = size_t(W) * size_t(H);
+    const size_t F = settings.formats.size();
+    r.width = W;
+    r.height = H;
+    r.nearZ = cam.nearZ;
+    r.farZ = cam.farZ;
+    r.formats = settings.formats;
+    r.pixelClass.assign(N, uint8_t(ZPixelClass::none));
+    r.fightMask.assign(N, 0);
+    r.hotspotOf.assign(N, 0);
+    r.perFormat.resize(F);
+    for (size_t i = 0; i < F; ++i) {
+        const DepthFormatInfo &info = depthFormatInfo(settings.formats[i].format);
+        r.perFormat[i].format = settings.formats[i];
+        r.perFormat[i].name = depthFormatName(settings.formats[i]);
+        r.perFormat[i].bits = info.bits;
+    }
+
+    // 1. Two nearest surfaces.
+    const TwoNearest two = findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided);
+    for (size_t p = 0; p < N; ++p) {
+        if (two.screen1[p] != kNoFragment) ++r.coveredPixels;
+        if (two.screen2[p] != kNoFragment) ++r.twoSurfacePixels;
+    }
+
+    // 2. Per format: the fight bit (key(d1) >= key(d2), d1 <= d2: equal stored values or swapped
+    //    order) and out-of-range pixels (either surface clamped by the encoder).
+    for (size_t i = 0; i < F; ++i) {
+        const DepthEncoder enc = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
+        const uint32_t bit = uint32_t(1) << i;
+        uint64_t oor = 0;
+        // Shortcut for the (many) one-surface pixels, exact: every format clamps d into
+        // [minValidDepth, hi] with hi = far or +inf (render/depth_format_impl.h), so a depth in
+        // [minValidDepth, far] is never out of range and needs no encoding; others are encoded.
+        const double lo = enc.minValidDepth, hi = enc.farZ;
+        dispatchDepthFormat(enc.format, [&]<DepthFormat Fmt>() {
+            for (size_t p = 0; p < N; ++p) {
+                if (two.screen1[p] == kNoFragment) continue;
+                uint32_t k1 = 0, k2 = 0;
+                bool o1 = false, o2 = false;
+                const double d1 = two.depth1[p];
+                if (two.screen2[p] != kNoFragment) {
+                    encodeDepth<Fmt>(enc, d1, k1, o1);
+                    encodeDepth<Fmt>(enc, two.depth2[p], k2, o2);
+                    if (k1 >= k2) r.fightMask[p] |= bit;
+                } else if (!(d1 >= lo && d1 <= hi)) {
+                    encodeDepth<Fmt>(enc, d1, k1, o1);
+                }
+                oor += (o1 || o2) ? 1 : 0;
+            }
+        });
+        r.perFormat[i].outOfRangePixels = oor;
+    }
+
+    // 3. Classify the pixels that fight somewhere: shared_edge, then intersection (never for
+    //    coplanar triangles: they have no intersection line), then coplanar, else separated.
+    PairCache pairs{scene, cam, {}};
+    double minSeparatedGap = kInf;  // smallest d2 - d1 over separated fighting pixels (for the text)
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * size_t(W) + size_t(x);
+            const uint32_t mask = r.fightMask[p];
+            if (!mask) continue;
+            const uint32_t t1 = two.screen1[p], t2 = two.screen2[p];
+            const uint32_t s1 = tris.source[t1], s2 = tris.source[t2];
+            const PairInfo &info = pairs.get(s1, s2);
+            ZPixelClass c = ZPixelClass::separated;
+            if (info.sharedEdge && info.edgeOnScreen &&
+                distanceToSegment(x + 0.5, y + 0.5, info.ex0, info.ey0, info.ex1, info.ey1) <=
+                    settings.sharedEdgePixels)
+                c = ZPixelClass::shared_edge;
+            else if (!info.coplanar && planesCrossInPixel(tris.planes[tris.plane[t1]], tris.planes[tris.plane[t2]], x,
+                                                          y, cam.orthographic))
+                c = ZPixelClass::intersection;
+            else if (info.coplanar)
+                c = ZPixelClass::coplanar;
+            r.pixelClass[p] = uint8_t(c);
+            if (c == ZPixelClass::separated) minSeparatedGap = std::min(minSeparatedGap, two.depth2[p] - two.depth1[p]);
+            ++r.fightingPixelsAnyFormat;
+            switch (c) {
+            case ZPixelClass::separated: ++r.separatedPixels; break;
+            case ZPixelClass::coplanar: ++r.coplanarPixels; break;
+            case ZPixelClass::shared_edge: ++r.sharedEdgePixels; break;
+            case ZPixelClass::intersection: ++r.intersectionPixels; break;
+            case ZPixelClass::none: break;
+            }
+            for (size_t i = 0; i < F; ++i) {
+                if (!(mask >> i & 1)) continue;
+                ZFightFormatStats &st = r.perFormat[i];
+                switch (c) {
+                case ZPixelClass::coplanar: ++st.coplanarPixels; [[fallthrough]];
+                case ZPixelClass::separated: ++st.fightingPixels; break;
+                case ZPixelClass::shared_edge: ++st.sharedEdgePixels; break;
+                case ZPixelClass::intersection: ++st.intersectionPixels; break;
+                case ZPixelClass::none: break;
+                }
+            }
+        }
+
+    // 4. Hotspots: 8-connected components of separated/coplanar fighting pixels, flood-filled
+    //    from seeds in scan order (component k's seed is its first pixel in scan order).
+    auto isHotspotPixel = [&](size_t p) {
+        const auto c = ZPixelClass(r.pixelClass[p]);
+        return c == ZPixelClass::separated || c == ZPixelClass::coplanar;
+    };
+    struct Component {
+        size_t seed = 0;
+        uint64_t area = 0;
+        ZFightHotspot h;
+        std::vector<uint64_t> formatPixels;
+    };
+    std::vector<Component> comps;
+    std::vector<uint32_t> label(N, 0);  // 1-based component index; 0 = none
+    std::vector<size_t> stack, members;
+    std::vector<double> depths, gaps;
+    for (size_t seed = 0; seed < N; ++seed) {
+        if (label[seed] || !isHotspotPixel(seed)) continue;
+        comps.emplace_back();
+        const uint32_t id = uint32_t(comps.size());
+        Component &cp = comps.back();
+        cp.seed = seed;
+        cp.formatPixels.assign(F, 0);
+        ZFightHotspot &h = cp.h;
+        h.minX = W, h.minY = H, h.maxX = -1, h.maxY = -1;
+        members.clear();
+        stack.assign(1, seed);
+        label[seed] = id;
+        while (!stack.empty()) {
+            const size_t p = stack.back();
+            stack.pop_back();
+            members.push_back(p);
+            const int x = int(p % size_t(W)), y = int(p / size_t(W));
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int nx = x + dx, ny = y + dy;
+                    if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+                    const size_t q = size_t(ny) * size_t(W) + size_t(nx);
+                    if (label[q] || !isHotspotPixel(q)) continue;
+                    label[q] = id;
+                    stack.push_back(q);
+                }
+        }
+        // Statistics over the members.
+        depths.clear();
+        gaps.clear();
+        std::unordered_map<uint64_t, uint64_t> pairCount;
+        Vec3 sum;
+        for (size_t p : members) {
+            const int x = int(p % size_t(W)), y = int(p / size_t(W));
+            h.minX = std::min(h.minX, x), h.maxX = std::max(h.maxX, x);
+            h.minY = std::min(h.minY, y), h.maxY = std::max(h.maxY, y);
+            const double d1 = two.depth1[p], d2 = two.depth2[p];
+            sum = sum + worldPointAt(cam, x + 0.5, y + 0.5, d1);
+            depths.push_back(d1);
+            gaps.push_back(d2 - d1);  // >= 0: d1 <= d2 by construction
+            h.depthGapMax = std::max(h.depthGapMax, d2 - d1);
+            if (ZPixelClass(r.pixelClass[p]) == ZPixelClass::coplanar) ++h.coplanarPixels;
+            ++pairCount[PairCache::key(tris.source[two.screen1[p]], tris.source[two.screen2[p]])];
+            for (size_t i = 0; i < F; ++i) cp.formatPixels[i] += r.fightMask[p] >> i & 1;
+        }
+        cp.area = members.size();
+        h.area = cp.area;
+        h.centroid = sum / double(cp.area);
+        h.depth = median(depths);
+        h.depthGap = median(gaps);
+        uint64_t bestKey = 0, bestCount = 0;
+        for (const auto &[k, c] : pairCount)
+            if (c > bestCount || (c == bestCount && k < bestKey)) bestKey = k, bestCount = c;
+        h.triangleA = uint32_t(bestKey >> 32);
+        h.triangleB = uint32_t(bestKey & 0xFFFFFFFFu);
+        h.pairPixels = bestCount;
+        h.pairs = pairCount.size();
+    }
+
+    // Hotspots: components of at least minHotspotArea pixels, area descending, ties by seed.
+    std::vector<uint32_t> order;
+    for (uint32_t k = 0; k < comps.size(); ++k)
+        if (comps[k].area >= std::max<uint64_t>(settings.minHotspotArea, 1)) order.push_back(k);
+    std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+        return comps[a].area != comps[b].area ? comps[a].area > comps[b].area : comps[a].seed < comps[b].seed;
+    });
+    r.hotspotCount = order.size();
+    std::vector<uint32_t> idOfComp(comps.size(), 0);
+    for (size_t rank = 0; rank < order.size(); ++rank) {
+        Component &cp = comps[order[rank]];
+        idOfComp[order[rank]] = uint32_t(rank + 1);
+        for (size_t i = 0; i < F; ++i)
+            if (cp.formatPixels[i]) ++r.perFormat[i].hotspots;
+        if (rank >= settings.maxHotspotsListed) continue;
+        ZFightHotspot h = std::move(cp.h);
+        h.id = uint32_t(rank + 1);
+        h.objectA = sourceObjectName(scene, h.triangleA);
+        h.objectB = sourceObjectName(scene, h.triangleB);
+        for (size_t i = 0; i < F; ++i)
+            if (cp.formatPixels[i]) h.formats.push_back({settings.formats[i], cp.formatPixels[i]});
+        // 6. Why it fights, at its median depth and gap.
+        explainHotspot(cam.nearZ, cam.farZ, settings.viewFormat, h.coplanarPixels == h.area, &h);
+        r.hotspots.push_back(std::move(h));
+    }
+    for (size_t p = 0; p < N; ++p)
+        if (label[p]) r.hotspotOf[p] = idOfComp[label[p] - 1];
+
+    // 5. Recommendation: fewest bits with no non-coplanar fighting pixel; ties in settings order.
+    const ZFightFormatStats *best = nullptr, *leastFighting = nullptr;
+    for (const ZFightFormatStats &st : r.perFormat) {
+        const uint64_t genuine = st.fightingPixels - st.coplanarPixels;
+        if (genuine == 0 && (!best || st.bits < best->bits)) best = &st;
+        if (!leastFighting || genuine < leastFighting->fightingPixels - leastFighting->coplanarPixels)
+            leastFighting = &st;
+    }
+    if (best) {
+        r.recommended = best->format;
+        r.recommendation = best->name + std::string(": the fewest bits (") + std::to_string(best->bits) +
+                           ") with no fighting pixels in this view";
+    } else {
+        const uint64_t n = leastFighting->fightingPixels - leastFighting->coplanarPixels;
+        char gap[32];
+        std::snprintf(gap, sizeof gap, "%.3g", minSeparatedGap);
+        r.recommendation = "every format fights at surfaces that are not coplanar (fewest: " + leastFighting->name +
+                           ", " + std::to_string(n) + " pixels; surfaces down to " + gap +
+                           " m apart): move the surfaces apart, push the near plane out or pull the far plane in";
+    }
+    if (r.coplanarPixels > 0)
+        r.recommendation += "; coplanar surfaces fight in every format: offset the decal or use a depth bias (" +
+                            std::to_string(r.coplanarPixels) + " pixels, not counted here)";
+    return r;
+}
+
+}  // namespace va

@@ -1,0 +1,130 @@
+#include "analysis/stages/backface.h"
+
+#include <cmath>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+namespace va {
+
+namespace {
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+// Sign of the triangle's plane at point e, exactly: +1 when e is on the side from which
+// (v0, v1, v2) appear counter-clockwise (the front), -1 behind, 0 on the plane.
+int exactSide(Vec3 v0, Vec3 v1, Vec3 v2, Vec3 e) {
+    const CGAL::Orientation o = CGAL::orientation(Kernel::Point_3(v0.x, v0.y, v0.z), Kernel::Point_3(v1.x, v1.y, v1.z),
+                                                  Kernel::Point_3(v2.x, v2.y, v2.z), Kernel::Point_3(e.x, e.y, e.z));
+    // CGAL: POSITIVE when det[v1 - v0, v2 - v0, e - v0] > 0, i.e. when v0, v1, v2 appear
+    // counter-clockwise seen from e (checked: (0,0,0), (1,0,0), (0,1,0) from (0,0,1) is POSITIVE).
+    return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+}
+// The perspective filter: n.e + k in double, against a bound on its rounding error that covers the
+// computation of n and k from the vertices too (pbrt-style gamma bound, generous factor). The
+// magnitudes come precomputed per triangle (Scene::planeBounds), so the common case reads the plane
+// and two numbers, never the vertices. +1 front, -1 back, 0 undecided (the exact test decides).
+// eyeMax = maxAbs(eye).
+inline int filteredSide(const Scene &scene, uint32_t t, Vec3 eye, double eyeMax) {
+    const double *p = &scene.planes[4 * size_t(t)];
+    const double *b = &scene.planeBounds[2 * size_t(t)];
+    const double s = dot(Vec3{p[0], p[1], p[2]}, eye) + p[3];
+    const double err = gamma(12) * (b[0] * (eyeMax + b[1]));
+    return s > err ? 1 : (s < -err ? -1 : 0);
+}
+}  // namespace
+
+bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edgeOn) {
+    const double *p = &scene.planes[4 * size_t(t)];
+    const Vec3 n{p[0], p[1], p[2]};
+    if (edgeOn) *edgeOn = false;
+    if (cam.orthographic) {
+        // Front when the normal points against the view direction: n . (-forward) > 0. Where the
+        // sign is within the rounding of the dot product, keep the triangle (conservative).
+        const double s = -dot(n, cam.forward);
+        const double err = gamma(4) * (std::fabs(n.x * cam.forward.x) + std::fabs(n.y * cam.forward.y) +
+                                       std::fabs(n.z * cam.forward.z));
+        if (s == 0 && edgeOn) *edgeOn = true;
+        return s > -err;
+    }
+    const Vec3 &e = cam.eye;
+    if (const int side = filteredSide(scene, t, e, maxAbs(e)); side != 0) return side > 0;
+    const uint32_t *ix = &scene.indices[3 * size_t(t)];
+    const Vec3 v0 = scene.positions[ix[0]], v1 = scene.positions[ix[1]], v2 = scene.positions[ix[2]];
+    const int side = exactSide(v0, v1, v2, e);
+    if (side == 0 && edgeOn) *edgeOn = true;
+    return side > 0;
+}
+
+std::vector<ClipBatch> clipBatches(const Scene &scene, const TriangleLists &lists) {
+    std::vector<ClipBatch> batches;
+    batches.reserve(lists.objects.size());
+    for (size_t g = 0; g < lists.objects.size(); ++g) {
+        const SceneObject &ob = scene.objects[lists.objects[g]];
+        ClipBatch b;
+        b.vertexBegin = ob.vertexBegin;
+        b.vertexEnd = ob.vertexEnd;
+        b.triangles = lists.triangles.data() + lists.groupBegin[g];
+        b.count = lists.groupBegin[g + 1] - lists.groupBegin[g];
+        if (b.count) batches.push_back(b);
+    }
+    return batches;
+}
+
+TriangleLists allTriangles(const Scene &scene, const std::vector<uint32_t> &objects) {
+    TriangleLists l;
+    l.objects = objects;
+    l.groupBegin.reserve(objects.size() + 1);
+    for (uint32_t o : objects) {
+        l.groupBegin.push_back(uint32_t(l.triangles.size()));
+        const SceneObject &ob = scene.objects[o];
+        l.triangles.insert(l.triangles.end(), scene.objectTriangles.begin() + ob.triBegin,
+                           scene.objectTriangles.begin() + ob.triEnd);
+    }
+    l.groupBegin.push_back(uint32_t(l.triangles.size()));
+    return l;
+}
+
+BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &objects, const Camera &cam) {
+    BackfaceResult r;
+    TriangleLists &l = r.kept;
+    BackfaceStats &st = r.stats;
+    l.objects.reserve(objects.size());
+    uint64_t total = 0;
+    for (uint32_t o : objects) total += scene.objects[o].triEnd - scene.objects[o].triBegin;
+    l.triangles.reserve(total);
+    const double eyeMax = maxAbs(cam.eye);
+    for (uint32_t o : objects) {
+        const SceneObject &ob = scene.objects[o];
+        const uint32_t begin = uint32_t(l.triangles.size());
+        const uint32_t n = ob.triEnd - ob.triBegin;
+        if (scene.materialOf(ob).doubleSided) {
+            st.doubleSidedExempt += n;
+            l.triangles.insert(l.triangles.end(), scene.objectTriangles.begin() + ob.triBegin,
+                               scene.objectTriangles.begin() + ob.triEnd);
+        } else {
+            st.trianglesTested += n;
+            // isFrontFacing's filter with the eye's magnitude taken once; only where it cannot
+            // decide does the full test run.
+            const uint32_t *tris = scene.objectTriangles.data();
+            for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) {
+                const uint32_t t = tris[i];
+                const int side = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
+                bool edgeOn = false;
+                if (side > 0 || (side == 0 && isFrontFacing(scene, t, cam, &edgeOn))) {
+                    l.triangles.push_back(t);
+                } else {
+                    r.culled.push_back(t);
+                    ++st.trianglesCulled;
+                    st.edgeOn += edgeOn;
+                }
+            }
+        }
+        if (l.triangles.size() > begin) {  // objects with every triangle culled leave no group
+            l.objects.push_back(o);
+            l.groupBegin.push_back(begin);
+        }
+    }
+    l.groupBegin.push_back(uint32_t(l.triangles.size()));
+    return r;
+}
+
+}  // namespace va
