@@ -30,6 +30,308 @@ StageRecord skipped(const char *name, const std::string &reason) {
     r.reason = reason;
     return r;
 }
+
+StageRecord ran(const char *name, uint64_t in, uint64_t culled, uint64_t out, double ms) {
+    StageRecord r;
+    r.name = name;
+    r.ran = true;
+    r.trianglesIn = in;
+    r.trianglesCulled = culled;
+    r.trianglesOut = out;
+    r.ms = ms;
+    return r;
+}
+
+// The objects of `before` missing from `after` (both ascending).
+std::vector<uint32_t> removed(const std::vector<uint32_t> &before, const std::vector<uint32_t> &after) {
+    std::vector<uint32_t> out;
+    size_t k = 0;
+    for (uint32_t o : before) {
+        if (k < after.size() && after[k] == o)
+            ++k;
+        else
+            out.push_back(o);
+    }
+    return out;
+}
+
+// What one view's stages and audits share while they run.
+struct ViewContext {
+    const PreparedScene &ps;
+    const Scene &scene;
+    const ViewSpec &view;
+    const Camera &cam;
+    const PipelineSettings &s;
+    ViewResult &r;
+    std::vector<StageCulls> culls;  // what each culling stage removed, for the audit
+    bool stopped() const { return s.cancel && s.cancel->load(std::memory_order_relaxed) != 0; }
+};
+
+// ---- Object-culling stages ----------------------------------------------------------------------
+// The contract (docs/architecture.md, "The stage contract"): given the objects still in (ascending),
+// a stage keeps some (ascending) and stores its statistics in the view's result. runObjectStage does
+// the rest -- the skip record, timing, triangles in/culled/out, what the culling audit needs -- so a
+// new object stage is its file in analysis/stages/ and one line in kObjectStages.
+struct ObjectCull {
+    std::vector<uint32_t> kept;                   // ascending
+    std::optional<std::vector<uint32_t>> culled;  // the objects it removed, when the stage lists them
+                                                  //   (else: the difference of its input and `kept`)
+    std::optional<double> ms;                     // its own time where that excludes set-up (occlusion)
+    double designFarPlane = 0;                    // StageCulls::designFarPlane (a map's PVS)
+};
+struct ObjectStage {
+    const char *name;
+    std::string (*skip)(const ViewContext &);  // why it does not run here; empty: it runs
+    ObjectCull (*run)(ViewContext &, const std::vector<uint32_t> &objects);
+};
+
+bool hasPortals(const Scene &scene) { return !portalsSkipReason(scene); }
+bool hasPvs(const Scene &scene) { return !cellsSkipReason(scene); }
+
+// Cells: the scene's portals (from its file) or a map's PVS.
+std::string cellsSkip(const ViewContext &c) {
+    if (!hasPortals(c.scene) && !hasPvs(c.scene)) return "scene has no cells, portals or PVS";
+    return c.s.cells ? "" : "turned off by --no-cells";
+}
+ObjectCull cellsRun(ViewContext &c, const std::vector<uint32_t> &) {
+    ObjectCull out;
+    if (hasPortals(c.scene)) {
+        PortalResult p = cullPortals(c.scene, c.cam, c.s.portals);
+        c.r.cellsArePortals = true;
+        c.r.portals = p.stats;
+        c.r.cellsNote = p.note;
+        out.kept = std::move(p.visible);
+    } else {
+        CellsResult cr = cullCells(c.scene, c.cam);
+        c.r.cells = cr.stats;
+        c.r.cellsNote = cr.note;
+        out.kept = std::move(cr.visible);
+        // A map's PVS leaves out on purpose what lies beyond its designed far plane.
+        if (c.scene.bsp) out.designFarPlane = c.scene.bsp->farPlane.distance;
+    }
+    return out;
+}
+
+// Grid: the scene's uniform grid of objects, where it has no cells.
+std::string gridSkip(const ViewContext &c) {
+    if (const char *why = gridSkipReason(c.scene)) return why;
+    return c.s.grid ? "" : "turned off by --no-grid";
+}
+ObjectCull gridRun(ViewContext &c, const std::vector<uint32_t> &objects) {
+    GridResult g = cullGrid(c.scene, c.ps.grid, c.cam, &objects);
+    c.r.grid = g.stats;
+    return {std::move(g.visible), std::move(g.culled), {}, 0};
+}
+
+// Frustum: bounding spheres over the object BVH, of the objects the coarse stage kept.
+std::string frustumSkip(const ViewContext &c) { return c.s.frustum ? "" : "turned off by --no-frustum"; }
+ObjectCull frustumRun(ViewContext &c, const std::vector<uint32_t> &objects) {
+    FrustumResult f = cullFrustum(c.scene, c.ps.bvh, c.cam, &objects);
+    c.r.frustum = f.stats;
+    return {std::move(f.visible), {}, {}, 0};
+}
+
+// Occlusion: a depth pre-pass of the best occluders, a max-depth pyramid, conservative box tests.
+std::string occlusionSkip(const ViewContext &c) { return c.s.occlusion ? "" : "turned off by --no-occlusion"; }
+ObjectCull occlusionRun(ViewContext &c, const std::vector<uint32_t> &objects) {
+    OcclusionResult oc = cullOcclusion(c.scene, c.cam, objects, c.s.occlusionSettings);
+    c.r.occlusion = oc.stats;
+    return {std::move(oc.visible), std::move(oc.culled), oc.stats.prepassMs + oc.stats.testMs, 0};
+}
+
+// The object stages in the pipeline's fixed coarse-to-fine order (docs/architecture.md).
+constexpr ObjectStage kObjectStages[] = {
+    {"cells", cellsSkip, cellsRun},
+    {"grid", gridSkip, gridRun},
+    {"frustum", frustumSkip, frustumRun},
+    {"occlusion", occlusionSkip, occlusionRun},
+};
+
+void runObjectStage(ViewContext &c, const ObjectStage &stage, std::vector<uint32_t> &objects) {
+    const std::string why = stage.skip(c);
+    if (!why.empty()) {
+        c.r.stages.push_back(skipped(stage.name, why));
+        return;
+    }
+    const uint64_t in = trianglesOf(c.scene, objects);
+    const Stopwatch t0;
+    ObjectCull out = stage.run(c, objects);
+    const double ms = out.ms ? *out.ms : t0.ms();
+    if (c.s.audit) {
+        StageCulls sc;
+        sc.stage = stage.name;
+        sc.objects = out.culled ? std::move(*out.culled) : removed(objects, out.kept);
+        sc.designFarPlane = out.designFarPlane;
+        c.culls.push_back(std::move(sc));
+    }
+    objects = std::move(out.kept);
+    const uint64_t kept = trianglesOf(c.scene, objects);
+    c.r.stages.push_back(ran(stage.name, in, in - kept, kept, ms));
+}
+
+// ---- Triangle stages ----------------------------------------------------------------------------
+// Backface: plane at the eye, per triangle. Returns the triangles kept, per object.
+TriangleLists runBackface(ViewContext &c, const std::vector<uint32_t> &objects) {
+    if (!c.s.backface) {
+        c.r.stages.push_back(skipped("backface", "turned off by --no-backface"));
+        return allTriangles(c.scene, objects);
+    }
+    const Stopwatch t0;
+    BackfaceResult b = cullBackfaces(c.scene, objects, c.cam);
+    const double ms = t0.ms();
+    c.r.backface = b.stats;
+    if (c.s.audit) c.culls.push_back({"backface", {}, std::move(b.culled), true});
+    const uint64_t in = trianglesOf(c.scene, objects), out = b.kept.size();
+    c.r.stages.push_back(ran("backface", in, in - out, out, ms));
+    return std::move(b.kept);
+}
+
+// Clip: one batch per object (its vertex range is transformed once).
+ClipResult runClip(ViewContext &c, const TriangleLists &lists) {
+    const Stopwatch t0;
+    const std::vector<ClipBatch> batches = clipBatches(c.scene, lists);
+    ClipResult clip = clipTriangles(c.cam, MeshView{c.scene.positions.data(), c.scene.indices.data()}, batches, c.s.clip);
+    const double ms = t0.ms();
+    c.r.clip = clip.stats;
+    const ClipStats &cs = clip.stats;
+    // Out: screen triangles, after fan triangulation.
+    c.r.stages.push_back(ran("clip", lists.size(), cs.trivialRejected + cs.clippedAway + cs.edgeOn, cs.trianglesOut, ms));
+    return clip;
+}
+
+// Z-buffer: rasterize in the view's depth format. Returns the fragments per source triangle when an
+// audit needs them (wasted fragments), else empty.
+std::vector<uint32_t> runZBuffer(ViewContext &c, const ClipResult &clip) {
+    std::vector<uint32_t> fragmentsPerSource;
+    ZBufferSettings zs;
+    zs.encoder = makeDepthEncoder(c.view.depthFormat, c.cam.nearZ, c.cam.farZ);
+    zs.orthographic = c.cam.orthographic;
+    if (c.s.audit || c.s.detail) {
+        fragmentsPerSource.assign(c.scene.triangleCount(), 0);
+        zs.fragmentsPerSource = fragmentsPerSource.data();
+    }
+    const Stopwatch t0;
+    ZBufferResult z = rasterize(clip.out, c.cam.width, c.cam.height, zs);
+    const double ms = t0.ms();
+    c.r.zbuffer = z.stats;
+    c.r.buffer = std::move(z.buffer);
+    c.r.stages.push_back(ran("zbuffer", z.stats.trianglesIn, z.stats.trianglesEmpty, z.stats.trianglesDrawn, ms));
+    return fragmentsPerSource;
+}
+
+// Raycast: Embree primary rays over the whole scene with no culling (single-sided triangles seen
+// from their front only, as the reference sees them; ties to the lowest id), compared pixel by
+// pixel with the z-buffer; then the secondary rays the effects plan calls for.
+void runRaycast(ViewContext &c, const TriangleLists &lists) {
+    const PreparedScene &ps = c.ps;
+    const Scene &scene = c.scene;
+    ViewResult &r = c.r;
+    if (!ps.rays) {
+        r.stages.push_back(skipped("raycast", "turned off by --no-raycast"));
+        return;
+    }
+    const Stopwatch t0;
+    PrimaryOptions opt;
+    opt.rejectBackFaces = c.s.backface;
+    opt.doubleSided = ps.effectsData.doubleSided.data();
+    opt.planes = scene.planes.data();
+    opt.tiesToLowestId = true;
+    opt.keepBarycentrics = ps.effects.tracesRays();
+    r.raycastImage = ps.rays->castPrimary(c.cam, opt, &r.raycast);
+    r.raycastRan = true;
+    const uint64_t in = scene.objectTriangles.size();
+    uint64_t hit = 0;
+    std::vector<uint8_t> seen(scene.triangleCount(), 0);
+    for (uint32_t id : r.raycastImage.id)
+        if (id && !seen[id - 1]) {
+            seen[id - 1] = 1;
+            ++hit;
+        }
+    // Like with like: the z-buffer drew only what the culling stages kept (lists.triangles). Where
+    // the whole-scene rays hit a triangle outside that set, cast again over the set itself, so
+    // that a cull (judged by the culling audit) is never also counted as a disagreement.
+    std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
+    for (uint32_t t : lists.triangles) outOfSet[t] = 0;
+    uint64_t culledPixels = 0;
+    for (uint32_t id : r.raycastImage.id) culledPixels += id && outOfSet[id - 1];
+    RaycastImage sameSet;
+    if (culledPixels > 0) {
+        PrimaryOptions same = opt;
+        same.keepBarycentrics = false;
+        same.rejectSource = outOfSet.data();
+        sameSet = ps.rays->castPrimary(c.cam, same, nullptr);
+    }
+    // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
+    r.stages.push_back(ran("raycast", in, in - hit, hit, t0.ms()));
+    const RaycastImage &compared = culledPixels > 0 ? sameSet : r.raycastImage;
+    r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, c.cam,
+                              makeDepthEncoder(c.view.depthFormat, c.cam.nearZ, c.cam.farZ), ps.rays->origin());
+    r.crossCheck.culled = culledPixels;
+    r.crossCheck.recast = culledPixels > 0;
+    if (ps.effects.tracesRays() && !c.stopped()) {
+        r.effects = traceEffects(*ps.rays, c.cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
+        r.effectsRan = true;
+    }
+}
+
+// ---- Audits -------------------------------------------------------------------------------------
+// The reference visibility (no culling at all), and what each culling stage removed that is in fact
+// visible (false culls) or kept that is visible nowhere (wasted draws).
+void runCullingAudit(ViewContext &c, const TriangleLists &lists, std::vector<uint32_t> &fragmentsPerSource) {
+    ViewResult &r = c.r;
+    if (!c.s.audit) {
+        r.auditReason = "turned off by --no-audit";
+        return;
+    }
+    const Stopwatch t0;
+    // The ordering audit walks the reference's fragments again in other orders: kept for it,
+    // up to 4 per pixel (48 bytes a pixel; estimateMemory), above which it rasterizes again.
+    const uint64_t pixels = uint64_t(std::max(c.cam.width, 0)) * uint64_t(std::max(c.cam.height, 0));
+    const uint64_t cache = c.ps.bspTree ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
+    r.reference = referenceVisibility(c.scene, c.cam, cache);
+    r.cullAudit = auditCulling(c.scene, r.reference, c.culls, lists.triangles, &fragmentsPerSource, &c.cam);
+    // A map's PVS: the evidence of each false cull it made (camera leaf and cluster, faces, leafs,
+    // clusters, PVS bits, distances), for a reader to check against the map's bytes.
+    if (hasPvs(c.scene) && !hasPortals(c.scene) && c.s.cells)
+        for (size_t k = 0; k < c.culls.size(); ++k)
+            if (c.culls[k].stage == "cells") r.pvsEvidence = pvsEvidence(c.scene, c.cam, r.cells, r.reference, r.cullAudit, k);
+    r.auditMs = t0.ms();
+    r.auditRan = true;
+}
+
+// Draw orders against the reference -- painter's, BSP, scanline, overdraw by order, and the
+// A-buffer where the scene has transparency.
+void runOrderingAudit(ViewContext &c) {
+    ViewResult &r = c.r;
+    if (c.ps.bspTree && r.auditRan) {
+        OrderingSettings os = c.s.orderingSettings;
+        os.abufferMaxList = c.s.limits.maxABufferList;
+        r.ordering = analyzeOrdering(c.scene, c.cam, r.reference, *c.ps.bspTree, c.ps.effects.abuffer, os);
+        r.orderingRan = true;
+    } else {
+        r.orderingReason = c.ps.orderingReason.empty() ? "needs the reference visibility" : c.ps.orderingReason;
+    }
+}
+
+// Z-fighting of the two nearest surfaces per pixel, in every depth format, over exactly the
+// triangles the z-buffer drew.
+void runZFightAudit(ViewContext &c, const ClipResult &clip) {
+    ViewResult &r = c.r;
+    if (!c.s.zfight) {
+        r.zfightReason = "turned off by --no-zfight";
+        return;
+    }
+    const Stopwatch t0;
+    // The view's own format is always evaluated (budgets read its row) and explains hotspots.
+    ZFightSettings zs = c.s.zfightSettings;
+    zs.viewFormat = c.view.depthFormat;
+    if (std::find(zs.formats.begin(), zs.formats.end(), c.view.depthFormat) == zs.formats.end() &&
+        zs.formats.size() < 32)
+        zs.formats.push_back(c.view.depthFormat);
+    r.zfight = analyzeZFighting(c.scene, c.cam, clip.out, zs);
+    r.zfightMs = t0.ms();
+    r.zfightRan = true;
+}
 }  // namespace
 
 PreparedScene prepareScene(const Scene &scene) {
@@ -93,315 +395,38 @@ bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, C
 }
 
 ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Camera &cam, const PipelineSettings &s) {
-    const Scene &scene = *ps.scene;
     const Stopwatch tView;
     ViewResult r;
     r.spec = view;
     r.camera = cam;
+    ViewContext c{ps, *ps.scene, view, cam, s, r, {}};
     // Checked between stages: an interrupted view returns what it has, and analyzeScene discards it.
-    auto stopped = [&] { return s.cancel && s.cancel->load(std::memory_order_relaxed) != 0; };
-
-    std::vector<uint32_t> objects(scene.objects.size());  // the objects still in, ascending
+    std::vector<uint32_t> objects(c.scene.objects.size());  // the objects still in, ascending
     for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
-    std::vector<StageCulls> culls;  // what each culling stage removed, for the audit
-    // The objects of `before` missing from `after` (both ascending).
-    auto removed = [](const std::vector<uint32_t> &before, const std::vector<uint32_t> &after) {
-        std::vector<uint32_t> out;
-        size_t k = 0;
-        for (uint32_t o : before) {
-            if (k < after.size() && after[k] == o)
-                ++k;
-            else
-                out.push_back(o);
-        }
-        return out;
-    };
-
-    // Coarse stage: cells where the scene has them (portals from the scene file, or a map's PVS),
-    // the grid otherwise.
-    const bool hasPortals = !portalsSkipReason(scene), hasPvs = !cellsSkipReason(scene);
-    {
-        StageRecord st;
-        st.name = "cells";
-        if (!hasPortals && !hasPvs) {
-            r.stages.push_back(skipped("cells", "scene has no cells, portals or PVS"));
-        } else if (!s.cells) {
-            r.stages.push_back(skipped("cells", "turned off by --no-cells"));
-        } else {
-            const Stopwatch t0;
-            st.trianglesIn = trianglesOf(scene, objects);
-            std::vector<uint32_t> visible;
-            if (hasPortals) {
-                PortalResult p = cullPortals(scene, cam, s.portals);
-                r.cellsArePortals = true;
-                r.portals = p.stats;
-                r.cellsNote = p.note;
-                visible = std::move(p.visible);
-            } else {
-                CellsResult c = cullCells(scene, cam);
-                r.cells = c.stats;
-                r.cellsNote = c.note;
-                visible = std::move(c.visible);
-            }
-            st.ms = t0.ms();
-            st.ran = true;
-            if (s.audit) {
-                culls.push_back({"cells", removed(objects, visible), {}});
-                // A map's PVS leaves out on purpose what lies beyond its designed far plane.
-                if (!hasPortals && scene.bsp) culls.back().designFarPlane = scene.bsp->farPlane.distance;
-            }
-            objects = std::move(visible);
-            st.trianglesOut = trianglesOf(scene, objects);
-            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-            r.stages.push_back(st);
-        }
-    }
-    {
-        StageRecord st;
-        st.name = "grid";
-        if (const char *why = gridSkipReason(scene)) {
-            r.stages.push_back(skipped("grid", why));
-        } else if (!s.grid) {
-            r.stages.push_back(skipped("grid", "turned off by --no-grid"));
-        } else {
-            const Stopwatch t0;
-            GridResult g = cullGrid(scene, ps.grid, cam, &objects);
-            st.ms = t0.ms();
-            st.ran = true;
-            st.trianglesIn = trianglesOf(scene, objects);
-            if (s.audit) culls.push_back({"grid", g.culled, {}});
-            objects = std::move(g.visible);
-            st.trianglesOut = trianglesOf(scene, objects);
-            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-            r.grid = g.stats;
-            r.stages.push_back(st);
-        }
-    }
-
-    // Frustum: bounding spheres over the object BVH, of the objects the coarse stage kept.
-    {
-        StageRecord st;
-        st.name = "frustum";
-        if (s.frustum) {
-            const Stopwatch t0;
-            FrustumResult f = cullFrustum(scene, ps.bvh, cam, &objects);
-            st.ms = t0.ms();
-            st.ran = true;
-            r.frustum = f.stats;
-            st.trianglesIn = trianglesOf(scene, objects);
-            if (s.audit) culls.push_back({"frustum", removed(objects, f.visible), {}});
-            objects = std::move(f.visible);
-            st.trianglesOut = trianglesOf(scene, objects);
-            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-            r.stages.push_back(st);
-        } else {
-            r.stages.push_back(skipped("frustum", "turned off by --no-frustum"));
-        }
-    }
-
-    // Occlusion: a depth pre-pass of the best occluders, a max-depth pyramid, conservative box tests.
-    {
-        StageRecord st;
-        st.name = "occlusion";
-        if (s.occlusion) {
-            OcclusionResult oc = cullOcclusion(scene, cam, objects, s.occlusionSettings);
-            st.ran = true;
-            st.ms = oc.stats.prepassMs + oc.stats.testMs;
-            st.trianglesIn = trianglesOf(scene, objects);
-            if (s.audit) culls.push_back({"occlusion", oc.culled, {}});
-            objects = std::move(oc.visible);
-            st.trianglesOut = trianglesOf(scene, objects);
-            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-            r.occlusion = oc.stats;
-            r.stages.push_back(st);
-        } else {
-            r.stages.push_back(skipped("occlusion", "turned off by --no-occlusion"));
-        }
-    }
-
-    if (stopped()) return r;
-    // Backface: plane at the eye, per triangle.
-    TriangleLists lists;
-    {
-        StageRecord st;
-        st.name = "backface";
-        if (s.backface) {
-            const Stopwatch t0;
-            BackfaceResult b = cullBackfaces(scene, objects, cam);
-            st.ms = t0.ms();
-            st.ran = true;
-            r.backface = b.stats;
-            lists = std::move(b.kept);
-            if (s.audit) culls.push_back({"backface", {}, std::move(b.culled), true});
-            st.trianglesIn = trianglesOf(scene, objects);
-            st.trianglesOut = lists.size();
-            st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-            r.stages.push_back(st);
-        } else {
-            lists = allTriangles(scene, objects);
-            r.stages.push_back(skipped("backface", "turned off by --no-backface"));
-        }
-    }
-
-    // Clip: one batch per object (its vertex range is transformed once).
-    ClipResult clip;
-    {
-        StageRecord st;
-        st.name = "clip";
-        const Stopwatch t0;
-        const std::vector<ClipBatch> batches = clipBatches(scene, lists);
-        clip = clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, batches, s.clip);
-        st.ms = t0.ms();
-        st.ran = true;
-        r.clip = clip.stats;
-        st.trianglesIn = lists.size();
-        st.trianglesCulled = clip.stats.trivialRejected + clip.stats.clippedAway + clip.stats.edgeOn;
-        st.trianglesOut = clip.stats.trianglesOut;  // screen triangles, after fan triangulation
-        r.stages.push_back(st);
-    }
-
-    if (stopped()) return r;
-    // Z-buffer: rasterize in the view's depth format.
-    std::vector<uint32_t> fragmentsPerSource;  // per source triangle (audit: wasted fragments)
-    {
-        StageRecord st;
-        st.name = "zbuffer";
-        ZBufferSettings zs;
-        zs.encoder = makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ);
-        zs.orthographic = cam.orthographic;
-        if (s.audit || s.detail) {
-            fragmentsPerSource.assign(scene.triangleCount(), 0);
-            zs.fragmentsPerSource = fragmentsPerSource.data();
-        }
-        const Stopwatch t0;
-        ZBufferResult z = rasterize(clip.out, cam.width, cam.height, zs);
-        st.ms = t0.ms();
-        st.ran = true;
-        r.zbuffer = z.stats;
-        r.buffer = std::move(z.buffer);
-        st.trianglesIn = z.stats.trianglesIn;
-        st.trianglesCulled = z.stats.trianglesEmpty;
-        st.trianglesOut = z.stats.trianglesDrawn;
-        r.stages.push_back(st);
-    }
-
-    // Raycast: Embree primary rays over the whole scene with no culling (single-sided triangles seen
-    // from their front only, as the reference sees them; ties to the lowest id), compared pixel by
-    // pixel with the z-buffer; then the secondary rays the effects plan calls for.
-    if (stopped()) return r;
-    if (ps.rays) {
-        StageRecord st;
-        st.name = "raycast";
-        const Stopwatch t0;
-        PrimaryOptions opt;
-        opt.rejectBackFaces = s.backface;
-        opt.doubleSided = ps.effectsData.doubleSided.data();
-        opt.planes = scene.planes.data();
-        opt.tiesToLowestId = true;
-        opt.keepBarycentrics = ps.effects.tracesRays();
-        r.raycastImage = ps.rays->castPrimary(cam, opt, &r.raycast);
-        st.ran = true;
-        r.raycastRan = true;
-        st.trianglesIn = scene.objectTriangles.size();
-        std::vector<uint8_t> seen(scene.triangleCount(), 0);
-        for (uint32_t id : r.raycastImage.id)
-            if (id && !seen[id - 1]) {
-                seen[id - 1] = 1;
-                ++st.trianglesOut;
-            }
-        // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
-        st.trianglesCulled = st.trianglesIn - st.trianglesOut;
-        // Like with like: the z-buffer drew only what the culling stages kept (lists.triangles). Where
-        // the whole-scene rays hit a triangle outside that set, cast again over the set itself, so
-        // that a cull (judged by the culling audit) is never also counted as a disagreement.
-        std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
-        for (uint32_t t : lists.triangles) outOfSet[t] = 0;
-        uint64_t culledPixels = 0;
-        for (uint32_t id : r.raycastImage.id) culledPixels += id && outOfSet[id - 1];
-        RaycastImage sameSet;
-        if (culledPixels > 0) {
-            PrimaryOptions same = opt;
-            same.keepBarycentrics = false;
-            same.rejectSource = outOfSet.data();
-            sameSet = ps.rays->castPrimary(cam, same, nullptr);
-        }
-        st.ms = t0.ms();
-        r.stages.push_back(st);
-        const RaycastImage &compared = culledPixels > 0 ? sameSet : r.raycastImage;
-        r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, cam,
-                                  makeDepthEncoder(view.depthFormat, cam.nearZ, cam.farZ), ps.rays->origin());
-        r.crossCheck.culled = culledPixels;
-        r.crossCheck.recast = culledPixels > 0;
-        if (ps.effects.tracesRays() && !stopped()) {
-            r.effects = traceEffects(*ps.rays, cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
-            r.effectsRan = true;
-        }
-    } else {
-        r.stages.push_back(skipped("raycast", "turned off by --no-raycast"));
-    }
-
-    // Audit: the reference visibility (no culling at all), and what each culling stage removed
-    // that is in fact visible (false culls) or kept that is visible nowhere (wasted draws).
-    if (stopped()) return r;
-    if (s.audit) {
-        const Stopwatch t0;
-        // The ordering audit walks the reference's fragments again in other orders: kept for it,
-        // up to 4 per pixel (48 bytes a pixel; estimateMemory), above which it rasterizes again.
-        const uint64_t pixels = uint64_t(std::max(cam.width, 0)) * uint64_t(std::max(cam.height, 0));
-        const uint64_t cache = ps.bspTree ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
-        r.reference = referenceVisibility(scene, cam, cache);
-        r.cullAudit = auditCulling(scene, r.reference, culls, lists.triangles, &fragmentsPerSource, &cam);
-        // A map's PVS: the evidence of each false cull it made (camera leaf and cluster, faces, leafs,
-        // clusters, PVS bits, distances), for a reader to check against the map's bytes.
-        if (hasPvs && !hasPortals && s.cells)
-            for (size_t k = 0; k < culls.size(); ++k)
-                if (culls[k].stage == "cells") r.pvsEvidence = pvsEvidence(scene, cam, r.cells, r.reference, r.cullAudit, k);
-        r.auditMs = t0.ms();
-        r.auditRan = true;
-    } else {
-        r.auditReason = "turned off by --no-audit";
-    }
-
-    // Audit: draw orders against the reference -- painter's, BSP, scanline, overdraw by order, and
-    // the A-buffer where the scene has transparency.
-    if (stopped()) return r;
-    if (ps.bspTree && r.auditRan) {
-        OrderingSettings os = s.orderingSettings;
-        os.abufferMaxList = s.limits.maxABufferList;
-        r.ordering = analyzeOrdering(scene, cam, r.reference, *ps.bspTree, ps.effects.abuffer, os);
-        r.orderingRan = true;
-    } else {
-        r.orderingReason = ps.orderingReason.empty() ? "needs the reference visibility" : ps.orderingReason;
-    }
+    for (const ObjectStage &stage : kObjectStages) runObjectStage(c, stage, objects);
+    if (c.stopped()) return r;
+    const TriangleLists lists = runBackface(c, objects);
+    const ClipResult clip = runClip(c, lists);
+    if (c.stopped()) return r;
+    std::vector<uint32_t> fragmentsPerSource = runZBuffer(c, clip);
+    if (c.stopped()) return r;
+    runRaycast(c, lists);
+    if (c.stopped()) return r;
+    runCullingAudit(c, lists, fragmentsPerSource);
+    if (c.stopped()) return r;
+    runOrderingAudit(c);
     // The reference's screen triangles and fragments served the ordering audit only: a finished
     // view keeps neither (estimateMemory's finishedViews).
     r.reference.fragmentCache = FragmentCache{};
     r.reference.screen = ScreenTriangles{};
-
-    // Audit: detail -- triangles drawn against the pixels they show, too small, over-detailed.
-    if (stopped()) return r;
+    // Detail: triangles drawn against the pixels they show, too small, over-detailed.
+    if (c.stopped()) return r;
     if (s.detail) {
-        r.detail = auditDetail(scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
+        r.detail = auditDetail(c.scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
         r.detailRan = true;
     }
-
-    // Audit: z-fighting of the two nearest surfaces per pixel, in every depth format, over exactly
-    // the triangles the z-buffer drew.
-    if (stopped()) return r;
-    if (s.zfight) {
-        const Stopwatch t0;
-        // The view's own format is always evaluated (budgets read its row) and explains hotspots.
-        ZFightSettings zs = s.zfightSettings;
-        zs.viewFormat = view.depthFormat;
-        if (std::find(zs.formats.begin(), zs.formats.end(), view.depthFormat) == zs.formats.end() &&
-            zs.formats.size() < 32)
-            zs.formats.push_back(view.depthFormat);
-        r.zfight = analyzeZFighting(scene, cam, clip.out, zs);
-        r.zfightMs = t0.ms();
-        r.zfightRan = true;
-    } else {
-        r.zfightReason = "turned off by --no-zfight";
-    }
+    if (c.stopped()) return r;
+    runZFightAudit(c, clip);
     r.totalMs = tView.ms();
     return r;
 }
