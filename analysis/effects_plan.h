@@ -1,4 +1,4 @@
-// The effects planner (DESIGN.md, "Effects: simulate only what the scene calls for"): from the scene,
+// The effects planner (docs/architecture.md, "Effects: simulate only what the scene calls for"): from the scene,
 // which effects run and why; a flag forces any of them on or off. The plan goes into the report, so
 // the promise "only the effects a scene calls for" is visible. Rules: docs/effects.md.
 #pragma once

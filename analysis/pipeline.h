@@ -1,4 +1,4 @@
-// The pipeline: which stages a view runs, in DESIGN.md's fixed coarse-to-fine order, and the
+// The pipeline: which stages a view runs, in docs/architecture.md's fixed coarse-to-fine order, and the
 // glue that turns the scene model into the plain data render/ works on.
 #pragma once
 

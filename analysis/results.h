@@ -59,7 +59,7 @@ struct ViewResult {
     std::string imageBase;            // file-name base of its images (empty: derived from the name)
     ViewSpec spec;
     Camera camera;
-    std::vector<StageRecord> stages;  // in DESIGN.md's fixed order
+    std::vector<StageRecord> stages;  // in docs/architecture.md's fixed order
     FrustumStats frustum;
     BackfaceStats backface;
     ClipStats clip;

@@ -1,4 +1,4 @@
-// The scene model (DESIGN.md, Scene model). Owned by analysis/; render/ never sees it.
+// The scene model (docs/architecture.md, Scene model). Owned by analysis/; render/ never sees it.
 #pragma once
 
 #include <cstdint>

@@ -3,7 +3,7 @@
 
 namespace va {
 
-// Exit codes (DESIGN.md, Errors).
+// Exit codes (docs/architecture.md, Errors).
 enum ExitCode { kExitOk = 0, kExitBudgetFailed = 1, kExitBadInput = 2, kExitInternal = 3 };
 
 int runCli(int argc, char **argv);

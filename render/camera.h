@@ -1,4 +1,4 @@
-// The camera model shared by the z-buffer, the clipper and the ray caster (DESIGN.md, Conventions).
+// The camera model shared by the z-buffer, the clipper and the ray caster (docs/architecture.md, Conventions).
 //
 // View space: the camera looks down -z, +y up, +x right; view depth d = -z_view > 0.
 // Clip space (D3D-style depth range): x_c in [-w, w], y_c in [-w, w], z_c in [0, w], with

@@ -1,4 +1,4 @@
-// The clip stage: world triangles to screen triangles (DESIGN.md, Stages: clip).
+// The clip stage: world triangles to screen triangles (docs/architecture.md, Stages: clip).
 //
 // Each triangle is classified against the six clip planes in homogeneous clip space (camera.h):
 // trivially rejected (all three vertices outside one plane), inside (inside all planes of the view

@@ -1,4 +1,4 @@
-// Depth formats, emulated bit-exactly (DESIGN.md, "Depth formats").
+// Depth formats, emulated bit-exactly (docs/depth-formats.md, "Depth formats").
 //
 // A format maps a fragment's view depth d (double, > 0) to the value a depth buffer of that format
 // stores, with that format's own arithmetic. For the z-buffer every stored value is also mapped to
@@ -36,7 +36,7 @@ enum class DepthFormat : uint8_t {
     depth24plus,
 };
 constexpr int kDepthFormatCount = 18;
-// The first twelve formats (DESIGN.md's original table): the per-view z-fighting analysis's
+// The first twelve formats (docs/depth-formats.md's original table): the per-view z-fighting analysis's
 // default set (defaultZFightFormats), so its report fields stay as they were; the others are opt-in.
 constexpr int kClassicDepthFormatCount = 12;
 
@@ -45,10 +45,10 @@ struct DepthFormatInfo {
     const char *name;
     int bits;              // bits of the stored value
     bool nearerIsLarger;   // comparison direction of the stored value
-    const char *stored;    // the stored value's formula, as DESIGN.md writes it
+    const char *stored;    // the stored value's formula, as docs/depth-formats.md writes it
 };
 const DepthFormatInfo &depthFormatInfo(DepthFormat f);
-// All formats in DESIGN.md's table order (the order ties are broken in).
+// All formats in docs/depth-formats.md's table order (the order ties are broken in).
 const std::vector<DepthFormat> &allDepthFormats();
 // The formats the per-view z-fighting analysis evaluates unless told otherwise: the classic twelve.
 const std::vector<DepthFormat> &defaultZFightFormats();

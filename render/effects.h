@@ -1,4 +1,4 @@
-// Secondary rays from the visible points of a primary cast (DESIGN.md, "Effects: simulate only what the
+// Secondary rays from the visible points of a primary cast (docs/architecture.md, "Effects: simulate only what the
 // scene calls for"): shadow rays to each light, reflection rays from reflective materials, refraction
 // rays (with their Fresnel reflection) from refractive ones, recursion bounded by a maximum depth.
 // Plain data in (lights, a material table, a material index per source triangle); render/ never sees

@@ -1,4 +1,4 @@
-// The z-buffer rasterizer (DESIGN.md: Raster, Depth). Plain data in, plain data out.
+// The z-buffer rasterizer (docs/architecture.md: Raster, Depth). Plain data in, plain data out.
 //
 // Coverage: vertices in fixed point with kSubpixelBits fractional bits; edge functions in 64-bit
 // integers; a pixel is covered when its center (x + 0.5, y + 0.5) is inside the triangle, with the

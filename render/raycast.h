@@ -1,4 +1,4 @@
-// Ray casting with Embree 3 (DESIGN.md, Stages: raycast). Plain data in: world positions and
+// Ray casting with Embree 3 (docs/architecture.md, Stages: raycast). Plain data in: world positions and
 // triangles; the same camera model as the z-buffer (camera.h): one primary ray per pixel center,
 // direction with view-space z = -1 so the hit distance t is the view depth, t in [near, far].
 //
@@ -44,7 +44,7 @@ struct RaycastStats {
 struct PrimaryOptions {
     // Reference-visibility mode: a single-sided triangle is visible from its front only, so hits on the
     // back of single-sided triangles are rejected (the ray goes on to what lies behind). Front is
-    // decided per triangle with DESIGN.md's backface rule: the plane at the eye > 0 (perspective), or
+    // decided per triangle with docs/architecture.md's backface rule: the plane at the eye > 0 (perspective), or
     // the plane normal against the view direction < 0 (orthographic); exactly 0 (edge-on) is back.
     bool rejectBackFaces = false;
     // Per source triangle: nonzero = double-sided (never rejected). Null: every triangle single-sided.
@@ -54,7 +54,7 @@ struct PrimaryOptions {
     // in double from the float vertices Embree holds.
     const double *planes = nullptr;
     // Of two hits at a bit-identical distance (a ray exactly through a shared edge, coplanar
-    // triangles) keep the lower source id, as the reference visibility does (DESIGN.md, Ties).
+    // triangles) keep the lower source id, as the reference visibility does (docs/architecture.md, Ties).
     // Without it Embree keeps whichever it found last, which depends on the traversal: packet and
     // single-ray kernels can differ there.
     bool tiesToLowestId = false;

@@ -54,7 +54,7 @@ bool writeImageAtomic(const std::string &path, const char *format, const ImageSp
         return false;
     };
     // OpenImageIO stamps OpenEXR files with the current time (capDate) unless DateTime is set; an
-    // empty DateTime keeps the files byte-identical across runs (DESIGN.md: images are identical
+    // empty DateTime keeps the files byte-identical across runs (docs/architecture.md: images are identical
     // across runs, so CI can diff them).
     ImageSpec stamped = spec;
     if (!stamped.find_attribute("DateTime")) stamped.attribute("DateTime", "");

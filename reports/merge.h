@@ -1,4 +1,4 @@
-// Joining shard reports (DESIGN.md, Scale): `analyze --shard K/N` analyses every N-th view, any job
+// Joining shard reports (docs/architecture.md, Scale): `analyze --shard K/N` analyses every N-th view, any job
 // runner spreads the shards, and `merge` joins their folders into one report equal to the
 // unsharded run's apart from timings.
 #pragma once

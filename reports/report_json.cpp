@@ -767,7 +767,7 @@ void addOutputTimings(nlohmann::ordered_json *report, const OutputTimings &t) {
 
 // Totals over views, computed from the views' JSON alone, so that `merge` recomputes exactly what a
 // single run writes: per-stage culled triangles (stages in order of first appearance, which is
-// DESIGN.md's fixed order), z-buffer sums.
+// docs/architecture.md's fixed order), z-buffer sums.
 nlohmann::ordered_json reportTotals(const nlohmann::ordered_json &views) {
     std::vector<std::string> stageOrder;
     std::map<std::string, uint64_t> culled;

@@ -1,4 +1,4 @@
-// NAME.zfight.png: where a view z-fights (DESIGN.md, Outputs; docs/zfighting.md, "The image").
+// NAME.zfight.png: where a view z-fights (docs/architecture.md, Outputs; docs/zfighting.md, "The image").
 //
 // The view as dimmed gray depth (the depth PNG's log-scale gray at half brightness, background
 // black); every hotspot pixel filled with its hotspot's color and its bounding box outlined in that

@@ -69,7 +69,7 @@ nlohmann::json withoutTimings(nlohmann::json j) {
     return j;
 }
 
-// The index of the stage named `name` in a view's "stages" (DESIGN.md's fixed order), or -1.
+// The index of the stage named `name` in a view's "stages" (docs/architecture.md's fixed order), or -1.
 int stageIndex(const nlohmann::json &view, const std::string &name) {
     for (size_t i = 0; i < view["stages"].size(); ++i)
         if (view["stages"][i]["name"] == name) return int(i);

@@ -1,4 +1,4 @@
-// Depth formats: hand-computed stored values, ordering keys, range handling (DESIGN.md, Depth formats).
+// Depth formats: hand-computed stored values, ordering keys, range handling (docs/depth-formats.md, Depth formats).
 #include <gtest/gtest.h>
 
 #include <algorithm>

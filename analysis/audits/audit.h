@@ -1,4 +1,4 @@
-// Audits against the truth (DESIGN.md, Audits; docs/audits.md): reference visibility with no
+// Audits against the truth (docs/architecture.md, Audits; docs/audits.md): reference visibility with no
 // culling at all, the false culls and wasted draws of every culling stage, and the pixel-by-pixel
 // cross-check of the z-buffer against ray casting. Free functions over plain data; the pipeline
 // calls them per view (docs/audits.md, "Integration").

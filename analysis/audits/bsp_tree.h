@@ -1,4 +1,4 @@
-// A BSP tree over the scene's view-independent triangles (DESIGN.md, Audits: Ordering;
+// A BSP tree over the scene's view-independent triangles (docs/architecture.md, Audits: Ordering;
 // docs/ordering.md). Built once per scene; traversed per view back to front (painter's order
 // that is always right) or front to back (least overdraw with a depth test).
 //

@@ -1,4 +1,4 @@
-// View-independent depth-format audit (DESIGN.md, Audits: "Depth formats"; docs/depth-formats.md).
+// View-independent depth-format audit (docs/depth-formats.md, Audits: "Depth formats"; docs/depth-formats.md).
 //
 // For a near/far pair and a list of formats, measures from each format's own arithmetic
 // (render/depth_format.h: depthKey / depthStoredValue, exactly what the z-buffer stores):
@@ -155,7 +155,7 @@ struct DepthFightDistance {
 
 struct DepthFormatAudit {
     DepthFormatSpec format;          // the format (log24's C included)
-    std::string name;                // format name as DESIGN.md and --formats spell it (log24:C=X)
+    std::string name;                // format name as docs/depth-formats.md and --formats spell it (log24:C=X)
     int bits = 0;                    // bits of the stored value
     bool nearerIsLarger = false;     // comparison direction of the stored value
     // Distinct stored values over [near, far] (exact, from the ordering keys: key(far) - key(near)

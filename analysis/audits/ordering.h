@@ -1,4 +1,4 @@
-// Draw order and exact order (DESIGN.md, Audits: Ordering; docs/ordering.md): the painter's
+// Draw order and exact order (docs/architecture.md, Audits: Ordering; docs/ordering.md): the painter's
 // algorithm and the ambiguities it cannot resolve, BSP traversal, overdraw under each draw order,
 // the scanline and A-buffer methods, and the per-view `ordering` table of what each method costs in
 // time next to what it gets wrong.

@@ -1,4 +1,4 @@
-// Per-view z-fighting analysis (DESIGN.md, Audits: "Depth formats"; rules in docs/zfighting.md).
+// Per-view z-fighting analysis (docs/depth-formats.md, Audits: "Depth formats"; rules in docs/zfighting.md).
 //
 // For one view, from the screen triangles the z-buffer draws (the clip stage's output):
 //   1. the two nearest surfaces at every pixel: the nearest and second-nearest fragments from
@@ -71,7 +71,7 @@ const char *zPixelClassName(ZPixelClass c);
 // ---- Settings and result ----------------------------------------------------------------------
 
 struct ZFightSettings {
-    // Evaluated formats, in tie-break order: by default DESIGN.md's classic twelve
+    // Evaluated formats, in tie-break order: by default docs/depth-formats.md's classic twelve
     // (defaultZFightFormats); the others (and log24:C=X) are opt-in.
     std::vector<DepthFormatSpec> formats{defaultZFightFormats().begin(), defaultZFightFormats().end()};
     // The view's own format (the pipeline sets it): each hotspot gives its bucket width. Unset: the
@@ -155,7 +155,7 @@ struct ZFightResult {
     std::vector<ZFightHotspot> hotspots;        // the first maxHotspotsListed of them, by id
 
     // The format with the fewest bits whose fightingPixels - coplanarPixels is 0 (ties: settings
-    // order, which is DESIGN.md's table order by default). Absent when every format fights at
+    // order, which is docs/depth-formats.md's table order by default). Absent when every format fights at
     // non-coplanar surfaces. recommendation says why, in one sentence, and names coplanar pixels
     // when there are any ("coplanar surfaces fight in every format: offset the decal or use a
     // depth bias").

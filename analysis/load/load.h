@@ -34,7 +34,7 @@ bool loadMeshFile(const std::string &path, RawMesh *out, std::string *err);
 bool loadGltf(const std::string &path, SceneBuildInput *out, std::string *err,
               uint64_t maxTriangles = kDefaultMaxTriangles, uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 
-// Reads a views file: { "views": [ ... ] } with DESIGN.md's view keys.
+// Reads a views file: { "views": [ ... ] } with docs/scene-format.md's view keys.
 // Views without "up" get the file's top-level "up" axis if it has one, else the y axis.
 bool loadViewsFile(const std::string &path, std::vector<ViewSpec> *out, std::string *err,
                    uint64_t maxJsonDepth = kDefaultMaxJsonDepth);

@@ -110,7 +110,7 @@ struct Reader {
         return true;
     }
 
-    // One view object (DESIGN.md's view keys). `index` names unnamed views "view<index>".
+    // One view object (docs/scene-format.md's view keys). `index` names unnamed views "view<index>".
     bool view(const Json &j, const Path &p, size_t index, Vec3 defaultUp, ViewSpec *out) {
         if (!object(j, p)) return false;
         if (!checkKeys(j, p, {"name", "eye", "target", "direction", "up", "fov_y", "ortho_height", "near", "far",

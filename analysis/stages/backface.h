@@ -1,4 +1,4 @@
-// The backface stage (DESIGN.md, Stages: backface): the plane of each triangle evaluated at the
+// The backface stage (docs/architecture.md, Stages: backface): the plane of each triangle evaluated at the
 // eye (perspective) or against the view direction (orthographic); > 0 is front-facing.
 // Double-sided materials are exempt. Where the double-precision sign is not certain (|value| within
 // its error bound) the exact orientation predicate decides, so the result is exact.

@@ -1,5 +1,5 @@
 // The cells stage for Quake 3 maps: the camera's leaf (a walk down the BSP tree), its cluster, and
-// the PVS row of that cluster (DESIGN.md, Stages: cells). Objects in clusters the camera's cluster
+// the PVS row of that cluster (docs/architecture.md, Stages: cells). Objects in clusters the camera's cluster
 // cannot see are culled. Conservative by construction: an object stays when ANY cluster holding one
 // of its faces is visible, objects in no cluster always stay, and a camera outside every cluster
 // (in the void, or inside a wall) culls nothing — as Quake 3's renderer, which then draws everything.

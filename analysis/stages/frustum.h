@@ -1,5 +1,5 @@
 // The frustum stage: bounding spheres of culling objects against the six view-frustum planes,
-// over a BVH of objects (DESIGN.md, Stages: frustum). Conservative: an object is culled only when
+// over a BVH of objects (docs/architecture.md, Stages: frustum). Conservative: an object is culled only when
 // its sphere is outside a plane by more than the arithmetic's error bound.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The grid stage: the coarse stage of scenes without cells (DESIGN.md, Stages: grid;
+// The grid stage: the coarse stage of scenes without cells (docs/architecture.md, Stages: grid;
 // docs/coarse-stages.md). A uniform grid over the scene's bounds; each culling object is registered
 // in every grid cell its AABB overlaps. Per view, grid cells outside the frustum's bounding box are
 // skipped at no cost, the others are tested box-against-planes (conservative), and an object is

@@ -1,4 +1,4 @@
-// The occlusion stage (DESIGN.md, Stages: occlusion; docs/coarse-stages.md): a depth pre-pass of a
+// The occlusion stage (docs/architecture.md, Stages: occlusion; docs/coarse-stages.md): a depth pre-pass of a
 // few selected occluders at the view's full resolution, a hierarchical max-depth pyramid (HiZ) over
 // it, and a conservative test of every other object's bounding box against it.
 //

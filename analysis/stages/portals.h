@@ -1,4 +1,4 @@
-// The cells stage for scenes with cells and portals (DESIGN.md, Stages: cells; docs/coarse-stages.md).
+// The cells stage for scenes with cells and portals (docs/architecture.md, Stages: cells; docs/coarse-stages.md).
 //
 // From the cell(s) holding the eye, a depth-first traversal through the portals: each portal of the
 // current cell is clipped (Sutherland-Hodgman, in 3D, against the current frustum's planes); when
