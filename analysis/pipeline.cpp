@@ -8,6 +8,7 @@
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
+#include "analysis/stage.h"
 #include "analysis/stages/backface.h"
 #include "analysis/stages/cells.h"
 #include "analysis/load/level_views.h"
@@ -55,96 +56,20 @@ std::vector<uint32_t> removed(const std::vector<uint32_t> &before, const std::ve
     return out;
 }
 
-// What one view's stages and audits share while they run.
-struct ViewContext {
-    const PreparedScene &ps;
-    const Scene &scene;
-    const ViewSpec &view;
-    const Camera &cam;
-    const PipelineSettings &s;
-    ViewResult &r;
-    std::vector<StageCulls> culls;  // what each culling stage removed, for the audit
-    bool stopped() const { return s.cancel && s.cancel->load(std::memory_order_relaxed) != 0; }
-};
+}  // namespace
 
-// ---- Object-culling stages ----------------------------------------------------------------------
-// The contract (docs/architecture.md, "The stage contract"): given the objects still in (ascending),
-// a stage keeps some (ascending) and stores its statistics in the view's result. runObjectStage does
-// the rest -- the skip record, timing, triangles in/culled/out, what the culling audit needs -- so a
-// new object stage is its file in analysis/stages/ and one line in kObjectStages.
-struct ObjectCull {
-    std::vector<uint32_t> kept;                   // ascending
-    std::optional<std::vector<uint32_t>> culled;  // the objects it removed, when the stage lists them
-                                                  //   (else: the difference of its input and `kept`)
-    std::optional<double> ms;                     // its own time where that excludes set-up (occlusion)
-    double designFarPlane = 0;                    // StageCulls::designFarPlane (a map's PVS)
-};
-struct ObjectStage {
-    const char *name;
-    std::string (*skip)(const ViewContext &);  // why it does not run here; empty: it runs
-    ObjectCull (*run)(ViewContext &, const std::vector<uint32_t> &objects);
-};
-
-bool hasPortals(const Scene &scene) { return !portalsSkipReason(scene); }
-bool hasPvs(const Scene &scene) { return !cellsSkipReason(scene); }
-
-// Cells: the scene's portals (from its file) or a map's PVS.
-std::string cellsSkip(const ViewContext &c) {
-    if (!hasPortals(c.scene) && !hasPvs(c.scene)) return "scene has no cells, portals or PVS";
-    return c.s.cells ? "" : "turned off by --no-cells";
-}
-ObjectCull cellsRun(ViewContext &c, const std::vector<uint32_t> &) {
-    ObjectCull out;
-    if (hasPortals(c.scene)) {
-        PortalResult p = cullPortals(c.scene, c.cam, c.s.portals);
-        c.r.cellsArePortals = true;
-        c.r.portals = p.stats;
-        c.r.cellsNote = p.note;
-        out.kept = std::move(p.visible);
-    } else {
-        CellsResult cr = cullCells(c.scene, c.cam);
-        c.r.cells = cr.stats;
-        c.r.cellsNote = cr.note;
-        out.kept = std::move(cr.visible);
-        // A map's PVS leaves out on purpose what lies beyond its designed far plane.
-        if (c.scene.bsp) out.designFarPlane = c.scene.bsp->farPlane.distance;
-    }
-    return out;
-}
-
-// Grid: the scene's uniform grid of objects, where it has no cells.
-std::string gridSkip(const ViewContext &c) {
-    if (const char *why = gridSkipReason(c.scene)) return why;
-    return c.s.grid ? "" : "turned off by --no-grid";
-}
-ObjectCull gridRun(ViewContext &c, const std::vector<uint32_t> &objects) {
-    GridResult g = cullGrid(c.scene, c.ps.grid, c.cam, &objects);
-    c.r.grid = g.stats;
-    return {std::move(g.visible), std::move(g.culled), {}, 0};
-}
-
-// Frustum: bounding spheres over the object BVH, of the objects the coarse stage kept.
-std::string frustumSkip(const ViewContext &c) { return c.s.frustum ? "" : "turned off by --no-frustum"; }
-ObjectCull frustumRun(ViewContext &c, const std::vector<uint32_t> &objects) {
-    FrustumResult f = cullFrustum(c.scene, c.ps.bvh, c.cam, &objects);
-    c.r.frustum = f.stats;
-    return {std::move(f.visible), {}, {}, 0};
-}
-
-// Occlusion: a depth pre-pass of the best occluders, a max-depth pyramid, conservative box tests.
-std::string occlusionSkip(const ViewContext &c) { return c.s.occlusion ? "" : "turned off by --no-occlusion"; }
-ObjectCull occlusionRun(ViewContext &c, const std::vector<uint32_t> &objects) {
-    OcclusionResult oc = cullOcclusion(c.scene, c.cam, objects, c.s.occlusionSettings);
-    c.r.occlusion = oc.stats;
-    return {std::move(oc.visible), std::move(oc.culled), oc.stats.prepassMs + oc.stats.testMs, 0};
-}
-
-// The object stages in the pipeline's fixed coarse-to-fine order (docs/architecture.md).
-constexpr ObjectStage kObjectStages[] = {
-    {"cells", cellsSkip, cellsRun},
-    {"grid", gridSkip, gridRun},
-    {"frustum", frustumSkip, frustumRun},
-    {"occlusion", occlusionSkip, occlusionRun},
+// The object stages in the pipeline's fixed coarse-to-fine order (docs/architecture.md). Each row
+// is defined in its stage's file (analysis/stage.h).
+extern const ObjectStage kCellsStage;      // analysis/stages/cells.cpp: portals or a map's PVS
+extern const ObjectStage kGridStage;       // analysis/stages/grid.cpp
+extern const ObjectStage kFrustumStage;    // analysis/stages/frustum.cpp
+extern const ObjectStage kOcclusionStage;  // analysis/stages/occlusion.cpp
+namespace {
+constexpr const ObjectStage *kObjectStages[] = {
+    &kCellsStage,
+    &kGridStage,
+    &kFrustumStage,
+    &kOcclusionStage,
 };
 
 void runObjectStage(ViewContext &c, const ObjectStage &stage, std::vector<uint32_t> &objects) {
@@ -403,7 +328,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // Checked between stages: an interrupted view returns what it has, and analyzeScene discards it.
     std::vector<uint32_t> objects(c.scene.objects.size());  // the objects still in, ascending
     for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
-    for (const ObjectStage &stage : kObjectStages) runObjectStage(c, stage, objects);
+    for (const ObjectStage *stage : kObjectStages) runObjectStage(c, *stage, objects);
     if (c.stopped()) return r;
     const TriangleLists lists = runBackface(c, objects);
     const ClipResult clip = runClip(c, lists);

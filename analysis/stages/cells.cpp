@@ -1,5 +1,6 @@
 // The PVS cells stage: leaf by BSP walk, cluster, PVS row, and per-object cluster sets.
 #include "analysis/stages/cells.h"
+#include "analysis/stage.h"
 
 namespace va {
 
@@ -66,5 +67,33 @@ CellsResult cullCells(const Scene &scene, const Camera &cam) {
     }
     return r;
 }
+
+
+// The pipeline's row (analysis/stage.h): the scene's portals (from its file) or a map's PVS.
+namespace {
+std::string cellsSkip(const ViewContext &c) {
+    if (!hasPortals(c.scene) && !hasPvs(c.scene)) return "scene has no cells, portals or PVS";
+    return c.s.cells ? "" : "turned off by --no-cells";
+}
+ObjectCull cellsRun(ViewContext &c, const std::vector<uint32_t> &) {
+    ObjectCull out;
+    if (hasPortals(c.scene)) {
+        PortalResult p = cullPortals(c.scene, c.cam, c.s.portals);
+        c.r.cellsArePortals = true;
+        c.r.portals = p.stats;
+        c.r.cellsNote = p.note;
+        out.kept = std::move(p.visible);
+    } else {
+        CellsResult cr = cullCells(c.scene, c.cam);
+        c.r.cells = cr.stats;
+        c.r.cellsNote = cr.note;
+        out.kept = std::move(cr.visible);
+        // A map's PVS leaves out on purpose what lies beyond its designed far plane.
+        if (c.scene.bsp) out.designFarPlane = c.scene.bsp->farPlane.distance;
+    }
+    return out;
+}
+}  // namespace
+extern const ObjectStage kCellsStage = {"cells", cellsSkip, cellsRun};
 
 }  // namespace va

@@ -1,4 +1,5 @@
 #include "analysis/stages/frustum.h"
+#include "analysis/stage.h"
 
 #include <algorithm>
 #include <cmath>
@@ -177,5 +178,18 @@ FrustumResult cullFrustum(const Scene &scene, const ObjectBvh &bvh, const Camera
     }
     return r;
 }
+
+
+// The pipeline's row (analysis/stage.h): bounding spheres over the object BVH, of the objects the
+// coarse stage kept.
+namespace {
+std::string frustumSkip(const ViewContext &c) { return c.s.frustum ? "" : "turned off by --no-frustum"; }
+ObjectCull frustumRun(ViewContext &c, const std::vector<uint32_t> &objects) {
+    FrustumResult f = cullFrustum(c.scene, c.ps.bvh, c.cam, &objects);
+    c.r.frustum = f.stats;
+    return {std::move(f.visible), {}, {}, 0};
+}
+}  // namespace
+extern const ObjectStage kFrustumStage = {"frustum", frustumSkip, frustumRun};
 
 }  // namespace va

@@ -1,5 +1,6 @@
 // The grid stage: build (object registration per cell, CSR) and per-view culling.
 #include "analysis/stages/grid.h"
+#include "analysis/stage.h"
 
 #include <algorithm>
 #include <cmath>
@@ -190,5 +191,20 @@ GridResult cullGrid(const Scene &scene, const Grid &grid, const Camera &cam, con
     }
     return r;
 }
+
+
+// The pipeline's row (analysis/stage.h): the coarse stage where the scene has no cells.
+namespace {
+std::string gridSkip(const ViewContext &c) {
+    if (const char *why = gridSkipReason(c.scene)) return why;
+    return c.s.grid ? "" : "turned off by --no-grid";
+}
+ObjectCull gridRun(ViewContext &c, const std::vector<uint32_t> &objects) {
+    GridResult g = cullGrid(c.scene, c.ps.grid, c.cam, &objects);
+    c.r.grid = g.stats;
+    return {std::move(g.visible), std::move(g.culled), {}, 0};
+}
+}  // namespace
+extern const ObjectStage kGridStage = {"grid", gridSkip, gridRun};
 
 }  // namespace va

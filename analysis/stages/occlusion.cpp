@@ -1,6 +1,7 @@
 // The occlusion stage: occluder selection, depth pre-pass through the fragment core, max-depth
 // pyramid, conservative box tests (docs/coarse-stages.md).
 #include "analysis/stages/occlusion.h"
+#include "analysis/stage.h"
 
 #include <algorithm>
 #include <cmath>
@@ -201,5 +202,17 @@ OcclusionResult cullOcclusion(const Scene &scene, const Camera &cam, const std::
     st.testMs = t1.ms();
     return r;
 }
+
+
+// The pipeline's row (analysis/stage.h). Its time is the pre-pass and the tests, without set-up.
+namespace {
+std::string occlusionSkip(const ViewContext &c) { return c.s.occlusion ? "" : "turned off by --no-occlusion"; }
+ObjectCull occlusionRun(ViewContext &c, const std::vector<uint32_t> &objects) {
+    OcclusionResult oc = cullOcclusion(c.scene, c.cam, objects, c.s.occlusionSettings);
+    c.r.occlusion = oc.stats;
+    return {std::move(oc.visible), std::move(oc.culled), oc.stats.prepassMs + oc.stats.testMs, 0};
+}
+}  // namespace
+extern const ObjectStage kOcclusionStage = {"occlusion", occlusionSkip, occlusionRun};
 
 }  // namespace va
