@@ -585,13 +585,8 @@ Json zbufferJson(const ZBufferStats &z) {
     return j;
 }
 
-}  // namespace
-
-nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
-    Json j;
-    j["format"] = kReportFormat;
-    j["tool"] = {{"name", "visaudit"}, {"version", VISAUDIT_VERSION}};
-
+// "scene": what was loaded, and a Quake 3 map's structure.
+Json sceneJson(const AnalysisResult &r) {
     Json scene;
     scene["path"] = r.scenePath;
     scene["triangles"] = r.triangles;
@@ -649,8 +644,11 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
                                                      : Json(nullptr);
         scene["bsp"]["fog_shader"] = r.bsp->fogShader.empty() ? Json(nullptr) : Json(r.bsp->fogShader);
     }
-    j["scene"] = scene;
-    j["load_ms"] = num(r.loadMs);
+    return scene;
+}
+
+// "bsp_tree" (the ordering audit's tree, built once) and "effects" (what the scene called for).
+void preparedJson(const AnalysisResult &r, Json &j) {
     Json decisions = Json::array();
     for (const EffectDecision &d : r.effects.all())
         decisions.push_back({{"name", d.name},
@@ -679,83 +677,102 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
                     {"ray_scene_build_ms", num(r.raySceneBuildMs)},
                     {"max_depth", r.effects.maxDepth},
                     {"decisions", decisions}};
+}
+
+// A view's "images": the file of each image it has, of those --images wrote.
+Json viewImagesJson(const ViewResult &v, const ViewImageNames &names, ImageSet images) {
+    Json im = {{"depth_exr", names.depthExr},
+               {"depth_png", names.depthPng},
+               {"overdraw_png", names.overdrawPng},
+               {"ids_exr", names.idsExr}};
+    if (v.zfightRan) im["zfight_png"] = names.zfightPng;
+    if (v.auditRan) im["culling_png"] = names.cullingPng;
+    if (v.orderingRan) {
+        const OrderingImageNames on = orderingImageNames(names.base);
+        im["painter_errors_png"] = on.painterErrorsPng;
+        im["overdraw_order_png"] = on.overdrawOrderPng;
+        if (v.ordering.abufferRan) im["abuffer_png"] = on.abufferPng;
+    }
+    if (v.raycastRan) {
+        im["raycast_ids_exr"] = names.raycastIdsExr;
+        im["raycast_diff_png"] = names.raycastDiffPng;
+    }
+    if (v.effectsRan) {
+        if (!v.effects.lights.empty()) {
+            Json shadows = Json::array();
+            for (size_t l = 0; l < v.effects.lights.size(); ++l) shadows.push_back(shadowImageName(names, l, v));
+            im["shadow_png"] = shadows;
+        }
+        im["secondary_png"] = names.secondaryPng;
+    }
+    // Only the images the run wrote (--images).
+    if (images != ImageSet::all) {
+        Json kept = Json::object();
+        for (auto it = im.begin(); it != im.end(); ++it)
+            if (imageWritten(images, it.key())) kept[it.key()] = it.value();
+        im = kept;
+    }
+    return im;
+}
+
+// One view's entry of "views".
+Json viewJson(const ViewResult &v, const std::string &base, const std::vector<std::string> &lightNames,
+              ImageSet images) {
+    Json vj;
+    vj["name"] = v.spec.name;
+    vj["index"] = v.index;
+    vj["origin"] = v.spec.origin;
+    vj["width"] = v.spec.camera.width;
+    vj["height"] = v.spec.camera.height;
+    vj["depth_format"] = depthFormatName(v.spec.depthFormat);
+    vj["projection"] = v.spec.camera.orthographic ? "orthographic" : "perspective";
+    vj["camera"] = cameraJson(v.spec.camera);
+    Json stages = Json::array();
+    for (const StageRecord &s : v.stages) {
+        stages.push_back(stageJson(s, v));
+    }
+    vj["stages"] = stages;
+    vj["zbuffer"] = zbufferJson(v.zbuffer);
+    const ViewImageNames names = viewImageNames(v.imageBase.empty() ? base : v.imageBase);
+    if (v.raycastRan)
+        vj["raycast"] = raycastJson(v, lightNames);
+    else
+        vj["raycast"] = {{"ran", false}, {"reason", "turned off by --no-raycast"}};
+    if (v.orderingRan)
+        vj["ordering"] = orderingJson(v.ordering);
+    else
+        vj["ordering"] = {{"ran", false}, {"reason", v.orderingReason}};
+    if (v.detailRan)
+        vj["detail"] = detailJson(v.detail);
+    else
+        vj["detail"] = {{"ran", false}, {"reason", "turned off by --no-detail"}};
+    if (v.auditRan)
+        vj["audit"] = auditJson(v);
+    else
+        vj["audit"] = {{"ran", false}, {"reason", v.auditReason}};
+    if (v.zfightRan)
+        vj["depth"] = depthJson(v.zfight, v.zfightMs);
+    else
+        vj["depth"] = {{"ran", false}, {"reason", v.zfightReason}};
+    vj["images"] = viewImagesJson(v, names, images);
+    vj["total_ms"] = num(v.totalMs);
+    return vj;
+}
+
+}  // namespace
+
+nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
+    Json j;
+    j["format"] = kReportFormat;
+    j["tool"] = {{"name", "visaudit"}, {"version", VISAUDIT_VERSION}};
+    j["scene"] = sceneJson(r);
+    j["load_ms"] = num(r.loadMs);
+    preparedJson(r, j);
     j["shard"] = {{"index", r.shard.index}, {"count", r.shard.count},
                   {"views_total", r.shard.viewsTotal ? r.shard.viewsTotal : r.views.size()}};
-
     const std::vector<std::string> bases = imageBaseNames(r.views);
     Json views = Json::array();
-    for (size_t i = 0; i < r.views.size(); ++i) {
-        const ViewResult &v = r.views[i];
-        Json vj;
-        vj["name"] = v.spec.name;
-        vj["index"] = v.index;
-        vj["origin"] = v.spec.origin;
-        vj["width"] = v.spec.camera.width;
-        vj["height"] = v.spec.camera.height;
-        vj["depth_format"] = depthFormatName(v.spec.depthFormat);
-        vj["projection"] = v.spec.camera.orthographic ? "orthographic" : "perspective";
-        vj["camera"] = cameraJson(v.spec.camera);
-        Json stages = Json::array();
-        for (const StageRecord &s : v.stages) {
-            stages.push_back(stageJson(s, v));
-        }
-        vj["stages"] = stages;
-        vj["zbuffer"] = zbufferJson(v.zbuffer);
-        const ViewImageNames names = viewImageNames(v.imageBase.empty() ? bases[i] : v.imageBase);
-        if (v.raycastRan)
-            vj["raycast"] = raycastJson(v, r.lightNames);
-        else
-            vj["raycast"] = {{"ran", false}, {"reason", "turned off by --no-raycast"}};
-        if (v.orderingRan)
-            vj["ordering"] = orderingJson(v.ordering);
-        else
-            vj["ordering"] = {{"ran", false}, {"reason", v.orderingReason}};
-        if (v.detailRan)
-            vj["detail"] = detailJson(v.detail);
-        else
-            vj["detail"] = {{"ran", false}, {"reason", "turned off by --no-detail"}};
-        if (v.auditRan)
-            vj["audit"] = auditJson(v);
-        else
-            vj["audit"] = {{"ran", false}, {"reason", v.auditReason}};
-        if (v.zfightRan)
-            vj["depth"] = depthJson(v.zfight, v.zfightMs);
-        else
-            vj["depth"] = {{"ran", false}, {"reason", v.zfightReason}};
-        vj["images"] = {{"depth_exr", names.depthExr},
-                        {"depth_png", names.depthPng},
-                        {"overdraw_png", names.overdrawPng},
-                        {"ids_exr", names.idsExr}};
-        if (v.zfightRan) vj["images"]["zfight_png"] = names.zfightPng;
-        if (v.auditRan) vj["images"]["culling_png"] = names.cullingPng;
-        if (v.orderingRan) {
-            const OrderingImageNames on = orderingImageNames(names.base);
-            vj["images"]["painter_errors_png"] = on.painterErrorsPng;
-            vj["images"]["overdraw_order_png"] = on.overdrawOrderPng;
-            if (v.ordering.abufferRan) vj["images"]["abuffer_png"] = on.abufferPng;
-        }
-        if (v.raycastRan) {
-            vj["images"]["raycast_ids_exr"] = names.raycastIdsExr;
-            vj["images"]["raycast_diff_png"] = names.raycastDiffPng;
-        }
-        if (v.effectsRan) {
-            if (!v.effects.lights.empty()) {
-                Json shadows = Json::array();
-                for (size_t l = 0; l < v.effects.lights.size(); ++l) shadows.push_back(shadowImageName(names, l, v));
-                vj["images"]["shadow_png"] = shadows;
-            }
-            vj["images"]["secondary_png"] = names.secondaryPng;
-        }
-        // Only the images the run wrote (--images).
-        if (images != ImageSet::all) {
-            Json kept = Json::object();
-            for (auto it = vj["images"].begin(); it != vj["images"].end(); ++it)
-                if (imageWritten(images, it.key())) kept[it.key()] = it.value();
-            vj["images"] = kept;
-        }
-        vj["total_ms"] = num(v.totalMs);
-        views.push_back(vj);
-    }
+    for (size_t i = 0; i < r.views.size(); ++i) views.push_back(viewJson(r.views[i], bases[i], r.lightNames, images));
     j["views"] = views;
     j["totals"] = reportTotals(j["views"]);
     return j;
