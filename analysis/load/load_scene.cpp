@@ -346,40 +346,15 @@ bool readCellsAndPortals(Reader &r, const Json &root, std::vector<Cell> *cellsOu
     return true;
 }
 
-bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
-    json::Doc doc;
-    if (!json::parseFile(path, &doc, err, opt.maxJsonDepth)) return false;
-    Reader r{doc, {}};
+// "materials": index 0 is "default"; a material named "default" redefines it.
+bool readMaterials(Reader &r, const Json &root, const Path &top, std::vector<Material> *materials,
+                   std::map<std::string, uint32_t> *materialIndex, std::string *err) {
     auto failed = [&] {
         *err = r.err;
         return false;
     };
-    const Json &root = doc.root;
-    const Path top;
-    if (!root.is_object()) {
-        *err = json::where(doc, top) + ": expected a JSON object with \"format\": \"" + kSceneFormat + "\", got " + json::typeName(root);
-        return false;
-    }
-    if (!r.checkKeys(root, top, {"format", "up", "materials", "objects", "lights", "views", "cells", "portals"}))
-        return failed();
-    if (!root.contains("format")) {
-        *err = json::where(doc, top) + ": missing \"format\": add \"format\": \"" + kSceneFormat + "\"";
-        return false;
-    }
-    std::string format;
-    if (!r.string(root["format"], top / "format", &format)) return failed();
-    if (format != kSceneFormat) {
-        r.fail(top / "format", "unsupported format \"" + format + "\"; this visaudit reads \"" + kSceneFormat + "\"");
-        return failed();
-    }
-
-    SceneBuildInput in;
-    in.path = path;
-    if (root.contains("up") && !r.upAxis(root["up"], top / "up", &in.up)) return failed();
-
-    // Materials: index 0 is "default"; a material named "default" redefines it.
-    in.materials.push_back(Material{});
-    std::map<std::string, uint32_t> materialIndex{{"default", 0}};
+    materials->push_back(Material{});
+    (*materialIndex)["default"] = 0;
     if (root.contains("materials")) {
         const Path mp = top / "materials";
         if (!r.object(root["materials"], mp)) return failed();
@@ -412,16 +387,117 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
                 }
             }
             if (m.name == "default") {
-                in.materials[0] = m;
+                (*materials)[0] = m;
             } else {
-                materialIndex[m.name] = uint32_t(in.materials.size());
-                in.materials.push_back(m);
+                (*materialIndex)[m.name] = uint32_t(materials->size());
+                materials->push_back(m);
             }
         }
     }
+    return true;
+}
 
-    // Objects: each loads its mesh (relative to the scene file's folder; each file read once) and
-    // applies world = T * R * S.
+// One object of "objects" (at `p`): its mesh loaded (relative to the scene file's folder; each file
+// read once, through `meshCache`) and world = T * R * S applied. `triangles` counts the objects' so
+// far: each object copies its mesh, so a small file instancing a large mesh many times is refused
+// before the copies.
+bool readObject(Reader &r, const json::Doc &doc, const Json &j, const Path &p, const std::filesystem::path &folder,
+                const LoadOptions &opt, const std::map<std::string, uint32_t> &materialIndex,
+                std::map<std::string, RawMesh> &meshCache, uint64_t *trianglesSoFar, SceneBuildInput::Object *out,
+                std::string *err) {
+    auto failed = [&] {
+        *err = r.err;
+        return false;
+    };
+    if (!r.object(j, p) ||
+        !r.checkKeys(j, p, {"name", "mesh", "material", "translate", "rotate_deg", "scale"}))
+        return failed();
+    SceneBuildInput::Object &o = *out;
+    if (!j.contains("mesh")) {
+        r.fail(p, "missing \"mesh\": give the mesh file (relative to the scene file), e.g. \"mesh\": \"meshes/hall.obj\"");
+        return failed();
+    }
+    if (!r.string(j["mesh"], p / "mesh", &o.mesh)) return failed();
+    o.name = std::filesystem::path(o.mesh).stem().string();
+    if (j.contains("name") && !r.string(j["name"], p / "name", &o.name)) return failed();
+    if (j.contains("material")) {
+        std::string mn;
+        if (!r.string(j["material"], p / "material", &mn)) return failed();
+        auto it = materialIndex.find(mn);
+        if (it == materialIndex.end()) {
+            std::vector<std::string> names;
+            for (const auto &[n, _] : materialIndex) names.push_back(n);
+            const std::string near = json::closest(mn, names);
+            r.fail(p / "material", "material '" + mn + "' is not defined in \"materials\"" +
+                                       (near.empty() ? "; defined: " + json::joinList(names)
+                                                     : "; did you mean '" + near + "'?"));
+            return failed();
+        }
+        o.material = it->second;
+    }
+    Vec3 t{0, 0, 0}, rot{0, 0, 0}, s{1, 1, 1};
+    if (j.contains("translate") && !r.vec3(j["translate"], p / "translate", &t)) return failed();
+    if (j.contains("rotate_deg") && !r.vec3(j["rotate_deg"], p / "rotate_deg", &rot)) return failed();
+    if (j.contains("scale")) {
+        const Json &sj = j["scale"];
+        if (sj.is_number()) {
+            double k = 0;
+            if (!r.number(sj, p / "scale", &k)) return failed();
+            s = {k, k, k};
+        } else if (sj.is_array()) {
+            if (!r.vec3(sj, p / "scale", &s)) return failed();
+        } else {
+            r.fail(p / "scale", "expected a number or an array of 3 numbers, got " + json::typeName(sj));
+            return failed();
+        }
+    }
+    // Load (or reuse) the mesh.
+    std::filesystem::path mp(o.mesh);
+    const std::string file = (mp.is_absolute() ? mp : folder / mp).lexically_normal().string();
+    auto cached = meshCache.find(file);
+    const bool firstUse = cached == meshCache.end();
+    if (firstUse) {
+        RawMesh m;
+        std::string e;
+        if (!loadMeshFile(file, &m, &e)) {
+            *err = json::where(doc, p / "mesh") + ": " + json::pathString(p / "mesh") + ": cannot load mesh '" +
+                   o.mesh + "' of object '" + o.name + "': " + e;
+            return false;
+        }
+        cached = meshCache.emplace(file, std::move(m)).first;
+    }
+    *trianglesSoFar += cached->second.indices.size() / 3;
+    if (!checkTriangleLimit(*trianglesSoFar, opt.maxTriangles,
+                            json::where(doc, p) + ": the scene up to object '" + o.name + "'", err))
+        return false;
+    o.geometry = cached->second;
+    if (!firstUse) o.geometry.warnings.clear();  // reported once, with the first object using the mesh
+    const Mat4 worldFromObject = Mat4::translate(t) * Mat4::rotateXYZDegrees(rot) * Mat4::scale(s);
+    for (auto &v : o.geometry.positions) v = transformPoint(worldFromObject, v);
+    // The mesh's own coordinates are finite (loadMeshFile refuses others): a non-finite one now
+    // comes from the transform overflowing. Point at the key that scales or moves the most.
+    for (size_t k = 0; k < o.geometry.positions.size(); ++k) {
+        if (isFinite(o.geometry.positions[k])) continue;
+        const char *key = j.contains("scale") ? "scale" : j.contains("translate") ? "translate" : "rotate_deg";
+        r.fail(p / key, "the transform maps vertex " + std::to_string(k) + " of '" + o.mesh +
+                            "' (counting from 0) to a non-finite position; use a smaller scale or translation");
+        return failed();
+    }
+    // An odd number of negative scale factors mirrors the mesh, turning counter-clockwise into
+    // clockwise: swap two corners so the front face stays counter-clockwise.
+    if (s.x * s.y * s.z < 0)
+        for (size_t k = 0; k + 2 < o.geometry.indices.size(); k += 3) std::swap(o.geometry.indices[k + 1], o.geometry.indices[k + 2]);
+    return true;
+}
+
+// "objects": every object, in order.
+bool readObjects(Reader &r, const json::Doc &doc, const Json &root, const Path &top, const std::string &path,
+                 const LoadOptions &opt, const std::map<std::string, uint32_t> &materialIndex,
+                 std::vector<SceneBuildInput::Object> *objects, std::string *err) {
+    auto failed = [&] {
+        *err = r.err;
+        return false;
+    };
     if (!root.contains("objects")) {
         *err = json::where(doc, top) + ": missing \"objects\": list the scene's meshes, e.g. \"objects\": "
                "[{ \"name\": \"hall\", \"mesh\": \"meshes/hall.obj\" }]";
@@ -437,90 +513,20 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
     uint64_t triangles = 0;  // of the objects so far: each object copies its mesh, so a small file
                              //   instancing a large mesh many times is refused before the copies
     for (size_t i = 0; i < root["objects"].size(); ++i) {
-        const Path p = op / i;
-        const Json &j = root["objects"][i];
-        if (!r.object(j, p) ||
-            !r.checkKeys(j, p, {"name", "mesh", "material", "translate", "rotate_deg", "scale"}))
-            return failed();
         SceneBuildInput::Object o;
-        if (!j.contains("mesh")) {
-            r.fail(p, "missing \"mesh\": give the mesh file (relative to the scene file), e.g. \"mesh\": \"meshes/hall.obj\"");
-            return failed();
-        }
-        if (!r.string(j["mesh"], p / "mesh", &o.mesh)) return failed();
-        o.name = std::filesystem::path(o.mesh).stem().string();
-        if (j.contains("name") && !r.string(j["name"], p / "name", &o.name)) return failed();
-        if (j.contains("material")) {
-            std::string mn;
-            if (!r.string(j["material"], p / "material", &mn)) return failed();
-            auto it = materialIndex.find(mn);
-            if (it == materialIndex.end()) {
-                std::vector<std::string> names;
-                for (const auto &[n, _] : materialIndex) names.push_back(n);
-                const std::string near = json::closest(mn, names);
-                r.fail(p / "material", "material '" + mn + "' is not defined in \"materials\"" +
-                                           (near.empty() ? "; defined: " + json::joinList(names)
-                                                         : "; did you mean '" + near + "'?"));
-                return failed();
-            }
-            o.material = it->second;
-        }
-        Vec3 t{0, 0, 0}, rot{0, 0, 0}, s{1, 1, 1};
-        if (j.contains("translate") && !r.vec3(j["translate"], p / "translate", &t)) return failed();
-        if (j.contains("rotate_deg") && !r.vec3(j["rotate_deg"], p / "rotate_deg", &rot)) return failed();
-        if (j.contains("scale")) {
-            const Json &sj = j["scale"];
-            if (sj.is_number()) {
-                double k = 0;
-                if (!r.number(sj, p / "scale", &k)) return failed();
-                s = {k, k, k};
-            } else if (sj.is_array()) {
-                if (!r.vec3(sj, p / "scale", &s)) return failed();
-            } else {
-                r.fail(p / "scale", "expected a number or an array of 3 numbers, got " + json::typeName(sj));
-                return failed();
-            }
-        }
-        // Load (or reuse) the mesh.
-        std::filesystem::path mp(o.mesh);
-        const std::string file = (mp.is_absolute() ? mp : folder / mp).lexically_normal().string();
-        auto cached = meshCache.find(file);
-        const bool firstUse = cached == meshCache.end();
-        if (firstUse) {
-            RawMesh m;
-            std::string e;
-            if (!loadMeshFile(file, &m, &e)) {
-                *err = json::where(doc, p / "mesh") + ": " + json::pathString(p / "mesh") + ": cannot load mesh '" +
-                       o.mesh + "' of object '" + o.name + "': " + e;
-                return false;
-            }
-            cached = meshCache.emplace(file, std::move(m)).first;
-        }
-        triangles += cached->second.indices.size() / 3;
-        if (!checkTriangleLimit(triangles, opt.maxTriangles,
-                                json::where(doc, p) + ": the scene up to object '" + o.name + "'", err))
+        if (!readObject(r, doc, root["objects"][i], op / i, folder, opt, materialIndex, meshCache, &triangles, &o, err))
             return false;
-        o.geometry = cached->second;
-        if (!firstUse) o.geometry.warnings.clear();  // reported once, with the first object using the mesh
-        const Mat4 worldFromObject = Mat4::translate(t) * Mat4::rotateXYZDegrees(rot) * Mat4::scale(s);
-        for (auto &v : o.geometry.positions) v = transformPoint(worldFromObject, v);
-        // The mesh's own coordinates are finite (loadMeshFile refuses others): a non-finite one now
-        // comes from the transform overflowing. Point at the key that scales or moves the most.
-        for (size_t k = 0; k < o.geometry.positions.size(); ++k) {
-            if (isFinite(o.geometry.positions[k])) continue;
-            const char *key = j.contains("scale") ? "scale" : j.contains("translate") ? "translate" : "rotate_deg";
-            r.fail(p / key, "the transform maps vertex " + std::to_string(k) + " of '" + o.mesh +
-                                "' (counting from 0) to a non-finite position; use a smaller scale or translation");
-            return failed();
-        }
-        // An odd number of negative scale factors mirrors the mesh, turning counter-clockwise into
-        // clockwise: swap two corners so the front face stays counter-clockwise.
-        if (s.x * s.y * s.z < 0)
-            for (size_t k = 0; k + 2 < o.geometry.indices.size(); k += 3) std::swap(o.geometry.indices[k + 1], o.geometry.indices[k + 2]);
-        in.objects.push_back(std::move(o));
+        objects->push_back(std::move(o));
     }
-    meshCache.clear();
+    return true;
+}
 
+// "lights": directional (a direction) or point (a position).
+bool readLights(Reader &r, const Json &root, const Path &top, std::vector<Light> *lights, std::string *err) {
+    auto failed = [&] {
+        *err = r.err;
+        return false;
+    };
     if (root.contains("lights")) {
         const Path lp = top / "lights";
         if (!root["lights"].is_array()) {
@@ -569,9 +575,47 @@ bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, 
                 r.fail(p / "type", "unknown light type \"" + type + "\"; use \"directional\" or \"point\"");
                 return failed();
             }
-            in.lights.push_back(l);
+            lights->push_back(l);
         }
     }
+    return true;
+}
+
+bool loadSceneJson(const std::string &path, const LoadOptions &opt, Scene *out, std::string *err) {
+    json::Doc doc;
+    if (!json::parseFile(path, &doc, err, opt.maxJsonDepth)) return false;
+    Reader r{doc, {}};
+    auto failed = [&] {
+        *err = r.err;
+        return false;
+    };
+    const Json &root = doc.root;
+    const Path top;
+    if (!root.is_object()) {
+        *err = json::where(doc, top) + ": expected a JSON object with \"format\": \"" + kSceneFormat + "\", got " + json::typeName(root);
+        return false;
+    }
+    if (!r.checkKeys(root, top, {"format", "up", "materials", "objects", "lights", "views", "cells", "portals"}))
+        return failed();
+    if (!root.contains("format")) {
+        *err = json::where(doc, top) + ": missing \"format\": add \"format\": \"" + kSceneFormat + "\"";
+        return false;
+    }
+    std::string format;
+    if (!r.string(root["format"], top / "format", &format)) return failed();
+    if (format != kSceneFormat) {
+        r.fail(top / "format", "unsupported format \"" + format + "\"; this visaudit reads \"" + kSceneFormat + "\"");
+        return failed();
+    }
+
+    SceneBuildInput in;
+    in.path = path;
+    if (root.contains("up") && !r.upAxis(root["up"], top / "up", &in.up)) return failed();
+
+    std::map<std::string, uint32_t> materialIndex;
+    if (!readMaterials(r, root, top, &in.materials, &materialIndex, err)) return false;
+    if (!readObjects(r, doc, root, top, path, opt, materialIndex, &in.objects, err)) return false;
+    if (!readLights(r, root, top, &in.lights, err)) return false;
     if (root.contains("views") && !r.views(root["views"], top / "views", upVector(in.up), "scene", &in.views))
         return failed();
 
