@@ -73,6 +73,8 @@ struct Face {
     int32_t shader, effect, type, vertex, nVertexes, meshvert, nMeshverts, width, height;
 };
 
+struct BspObj;  // a culling object before its geometry is read (Parser::run)
+
 class Parser {
 public:
     Parser(const uint8_t *d, size_t n, const std::string &name, const BspOptions &o, std::string *e)
@@ -112,6 +114,11 @@ private:
     bool brushes(BspLevel *level);
     bool models(BspLevel *level, uint64_t nFaces);
     void worldspawnKeys(BspLevel *level);
+    bool classify(const std::vector<Face> &fs, const std::vector<uint32_t> &modelOf, BspLevel *level,
+                  std::vector<FaceKind> *kind, uint64_t *drawnTriangles);
+    void geometry(const std::vector<Face> &fs, std::vector<BspObj> &objs, const std::vector<uint32_t> &order,
+                  uint64_t drawnTriangles, BspLevel *level, SceneBuildInput *out);
+    void warnings(const BspLevel &level, SceneBuildInput *out);
 };
 
 // ---- 1. Header --------------------------------------------------------------------------------------
@@ -594,40 +601,27 @@ uint64_t patchVertices(const Face &f, int L) {
 
 // ---- The whole file ---------------------------------------------------------------------------------
 
-bool Parser::run(SceneBuildInput *out, BspLevel *level) {
-    const int L = opt_.patchLevel;
-    if (L < 1 || L > kMaxPatchLevel)
-        return fail("patch level " + str(L) + " is outside 1.." + str(kMaxPatchLevel) + "; choose e.g. 5 (--patch-level)");
-    if (!header()) return false;
-    std::vector<Face> fs;
-    if (!entities(level) || !planes(level) || !nodes(level) || !leafs(level) || !visdata(level) || !faces(&fs) ||
-        !brushes(level))
-        return false;
-    level->faceShader.resize(fs.size());
-    for (size_t i = 0; i < fs.size(); ++i) level->faceShader[i] = uint32_t(fs[i].shader);
-    level->patchLevel = L;
-    const uint64_t nf = fs.size();
-    worldspawnKeys(level);
+// modelOf[f], owner[f], leafObj[l]...: no model, leaf or object.
+constexpr uint32_t kNone = 0xFFFFFFFFu;
 
+// A culling object of the map before its geometry is read.
+struct BspObj {
+    std::string name;
+    int32_t cluster = -1;
+    uint32_t model = 0;
+    std::vector<uint32_t> faces;     // ascending
+};
+
+// 3. Classify, count, and bound the output before allocating it: each face's kind, the counts by
+// kind, and the drawn faces' triangles (false when they exceed the limit).
+bool Parser::classify(const std::vector<Face> &fs, const std::vector<uint32_t> &modelOf, BspLevel *level,
+                      std::vector<FaceKind> *kindOut, uint64_t *drawnTrianglesOut) {
+    const int L = opt_.patchLevel;
+    const uint64_t nf = fs.size();
     // Shaders: char name[64], int surfaceFlags, int contents (72 bytes).
     auto flagsOf = [&](const Face &f) { return u32(rec(kShaders, uint64_t(f.shader)) + 64); };
     auto contentsOf = [&](const Face &f) { return u32(rec(kShaders, uint64_t(f.shader)) + 68); };
 
-    // Models: float mins[3], maxs[3]; int face, n_faces, brush, n_brushes (40 bytes). Model 0 is the
-    // world; the others are brush entities (doors, platforms, movers, triggers).
-    if (!models(level, nf)) return false;
-    if (!level->models.empty())
-        level->worldFirstFace = level->models[0].firstFace, level->worldFaceCount = level->models[0].faceCount;
-    // modelOf[f]: the first model holding face f (kNone: none).
-    constexpr uint32_t kNone = 0xFFFFFFFFu;
-    std::vector<uint32_t> modelOf(nf, kNone);
-    for (size_t m = 0; m < level->models.size(); ++m) {
-        const BspModel &md = level->models[m];
-        for (uint32_t k = 0; k < md.faceCount; ++k)
-            if (modelOf[md.firstFace + k] == kNone) modelOf[md.firstFace + k] = uint32_t(m);
-    }
-
-    // 3. Classify, count, and bound the output before allocating it.
     BspFaceCounts &fc = level->faceCounts;
     fc.faces = nf;
     std::vector<FaceKind> kind(nf, kDrawn);
@@ -677,7 +671,14 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
                     " triangles; lower the patch level (--patch-level) or raise the limit with --max-triangles " +
                     str(int64_t(drawnTriangles)) + ", or the file is damaged");
 
-    // 4. Objects. The leafs the world's tree reaches: the nodes are in pre-order (children after
+    *kindOut = std::move(kind);
+    *drawnTrianglesOut = drawnTriangles;
+    return true;
+}
+
+// 4a. The leafs the world's tree reaches, every leaf listing each face, and each face's owner.
+void indexFaceLeafs(BspLevel *level, uint64_t nf, std::vector<uint32_t> *ownerOut) {
+    // The leafs the world's tree reaches: the nodes are in pre-order (children after
     // their parents, checked by nodes()), so one pass in order marks every reachable node and leaf.
     const size_t nl = level->leafs.size();
     level->leafInTree.assign(nl, 0);
@@ -713,25 +714,28 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
     for (uint64_t f = 0; f < nf; ++f)
         for (uint32_t k = level->faceLeafsBegin[f]; k < level->faceLeafsBegin[f + 1] && owner[f] == kNone; ++k)
             if (level->leafInTree[level->faceLeafs[k]]) owner[f] = level->faceLeafs[k];
-    // The clusters of the leafs of the world's tree listing face f (a face straddling clusters is
-    // visible from any of them: keeping the union keeps the cells stage conservative).
-    auto faceClusters = [&](uint64_t f, std::vector<int32_t> *cl) {
-        for (uint32_t k = level->faceLeafsBegin[f]; k < level->faceLeafsBegin[f + 1]; ++k) {
-            const uint32_t l = level->faceLeafs[k];
-            if (level->leafInTree[l] && level->leafs[l].cluster >= 0) cl->push_back(level->leafs[l].cluster);
-        }
-    };
+    *ownerOut = std::move(owner);
+}
 
-    // The object list: leafs in order, then the drawn brush models 1.., then the unleafed world faces.
+// The clusters of the leafs of the world's tree listing face f (a face straddling clusters is
+// visible from any of them: keeping the union keeps the cells stage conservative).
+void faceClusters(const BspLevel &level, uint64_t f, std::vector<int32_t> *cl) {
+    for (uint32_t k = level.faceLeafsBegin[f]; k < level.faceLeafsBegin[f + 1]; ++k) {
+        const uint32_t l = level.faceLeafs[k];
+        if (level.leafInTree[l] && level.leafs[l].cluster >= 0) cl->push_back(level.leafs[l].cluster);
+    }
+}
+
+// 4b. The object list: leafs in order, then the drawn brush models 1.., then the unleafed world faces
+// (`order` is the source order).
+void groupObjects(BspLevel *level, const std::vector<FaceKind> &kind, const std::vector<uint32_t> &modelOf,
+                  const std::vector<uint32_t> &owner, std::vector<BspObj> *objsOut, std::vector<uint32_t> *orderOut) {
+    const uint64_t nf = kind.size();
+    const size_t nl = level->leafs.size();
+    BspFaceCounts &fc = level->faceCounts;
     // A brush model's faces go to "modelK" whatever leafs list them; its clusters are those of the
     // leafs its placed box reaches (BspModel::boxLeafs), the engine's own rule.
-    struct Obj {
-        std::string name;
-        int32_t cluster = -1;
-        uint32_t model = 0;
-        std::vector<uint32_t> faces;     // ascending
-    };
-    std::vector<Obj> objs;
+    std::vector<BspObj> objs;
     std::vector<uint32_t> leafObj(nl, kNone);
     std::vector<uint32_t> modelObj(level->models.size(), kNone);
     uint32_t unleafedObj = kNone;
@@ -768,7 +772,15 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         if (o != kNone) order.push_back(o);
     if (unleafedObj != kNone) order.push_back(unleafedObj);
 
-    // 5. Geometry. Vertex: float position[3], texcoord[2][2], normal[3]; ubyte color[4] (44 bytes).
+    *objsOut = std::move(objs);
+    *orderOut = std::move(order);
+}
+
+// 5. Geometry, object by object in source order, with each triangle's face and each object's clusters.
+void Parser::geometry(const std::vector<Face> &fs, std::vector<BspObj> &objs, const std::vector<uint32_t> &order,
+                      uint64_t drawnTriangles, BspLevel *level, SceneBuildInput *out) {
+    const int L = opt_.patchLevel;
+    // Vertex: float position[3], texcoord[2][2], normal[3]; ubyte color[4] (44 bytes).
     auto position = [&](uint64_t v) { return vec3f(rec(kVertexes, v)); };
     out->objects.clear();
     out->objects.reserve(order.size());
@@ -780,7 +792,7 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
     level->triangleFace.reserve(drawnTriangles);
     std::vector<Vec3> ctrl;
     for (uint32_t oi : order) {
-        Obj &o = objs[oi];
+        BspObj &o = objs[oi];
         SceneBuildInput::Object so;
         so.name = o.name;
         so.mesh = name_;
@@ -795,7 +807,7 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         const Vec3 offset = model.offset;
         for (uint32_t fi : o.faces) {
             const Face &f = fs[fi];
-            faceClusters(fi, &cl);
+            faceClusters(*level, fi, &cl);
             ++m.facesRead;
             const size_t trianglesBefore = m.indices.size() / 3;
             if (f.type == kPatch) {
@@ -825,9 +837,11 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
         out->objects.push_back(std::move(so));
     }
 
-    out->up = 'z';
-    out->path = name_;
-    out->materials = {Material{}};
+}
+
+// The loader's warnings: faces kept out of the objects, bad effects, brush entities never drawn.
+void Parser::warnings(const BspLevel &level, SceneBuildInput *out) {
+    const BspFaceCounts &fc = level.faceCounts;
     if (fc.sky + fc.nodraw + fc.nonSolid + fc.billboards + fc.bad > 0)
         out->warnings.push_back(name_ + ": kept out of the objects (docs/quake3.md): " + str(int64_t(fc.sky)) +
                                 " sky, " + str(int64_t(fc.nodraw)) + " nodraw, " + str(int64_t(fc.nonSolid)) +
@@ -840,11 +854,52 @@ bool Parser::run(SceneBuildInput *out, BspLevel *level) {
                                 "loads such maps)");
     if (fc.notDrawnEntity > 0) {
         uint64_t entities = 0;
-        for (const BspModel &md : level->models) entities += md.notDrawnFaces > 0;
+        for (const BspModel &md : level.models) entities += md.notDrawnFaces > 0;
         out->warnings.push_back(name_ + ": not geometry (docs/quake3.md, \"Brush entities\"): " +
                                 str(int64_t(fc.notDrawnEntity)) + " faces of " + str(int64_t(entities)) +
                                 " brush entities the engine never draws (trigger_*, models no entity spawns)");
     }
+}
+
+bool Parser::run(SceneBuildInput *out, BspLevel *level) {
+    const int L = opt_.patchLevel;
+    if (L < 1 || L > kMaxPatchLevel)
+        return fail("patch level " + str(L) + " is outside 1.." + str(kMaxPatchLevel) + "; choose e.g. 5 (--patch-level)");
+    if (!header()) return false;
+    std::vector<Face> fs;
+    if (!entities(level) || !planes(level) || !nodes(level) || !leafs(level) || !visdata(level) || !faces(&fs) ||
+        !brushes(level))
+        return false;
+    level->faceShader.resize(fs.size());
+    for (size_t i = 0; i < fs.size(); ++i) level->faceShader[i] = uint32_t(fs[i].shader);
+    level->patchLevel = L;
+    const uint64_t nf = fs.size();
+    worldspawnKeys(level);
+
+    // Models: float mins[3], maxs[3]; int face, n_faces, brush, n_brushes (40 bytes). Model 0 is the
+    // world; the others are brush entities (doors, platforms, movers, triggers).
+    if (!models(level, nf)) return false;
+    if (!level->models.empty())
+        level->worldFirstFace = level->models[0].firstFace, level->worldFaceCount = level->models[0].faceCount;
+    // modelOf[f]: the first model holding face f (kNone: none).
+    std::vector<uint32_t> modelOf(nf, kNone);
+    for (size_t m = 0; m < level->models.size(); ++m) {
+        const BspModel &md = level->models[m];
+        for (uint32_t k = 0; k < md.faceCount; ++k)
+            if (modelOf[md.firstFace + k] == kNone) modelOf[md.firstFace + k] = uint32_t(m);
+    }
+    std::vector<FaceKind> kind;
+    uint64_t drawnTriangles = 0;
+    if (!classify(fs, modelOf, level, &kind, &drawnTriangles)) return false;
+    std::vector<uint32_t> owner, order;
+    indexFaceLeafs(level, nf, &owner);
+    std::vector<BspObj> objs;
+    groupObjects(level, kind, modelOf, owner, &objs, &order);
+    geometry(fs, objs, order, drawnTriangles, level, out);
+    out->up = 'z';
+    out->path = name_;
+    out->materials = {Material{}};
+    warnings(*level, out);
     return true;
 }
 
