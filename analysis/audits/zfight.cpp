@@ -347,67 +347,72 @@ void explainHotspot(double nearZ, double farZ, const std::optional<DepthFormatSp
 
 // ---- The analysis -----------------------------------------------------------------------------
 
-ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const ScreenTriangles &tris,
-                              const ZFightSettings &settings) {
-    ZFightResult r;
-    if (!validate(settings, cam, &r.error)) return r;
-    const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
-    const size_t N = size_t(W) * size_t(H);
-    const size_t F = settings.formats.size();
-    r.width = W;
-    r.height = H;
-    r.nearZ = cam.nearZ;
-    r.farZ = cam.farZ;
-    r.formats = settings.formats;
-    r.pixelClass.assign(N, uint8_t(ZPixelClass::none));
-    r.fightMask.assign(N, 0);
-    r.hotspotOf.assign(N, 0);
-    r.perFormat.resize(F);
-    for (size_t i = 0; i < F; ++i) {
-        const DepthFormatInfo &info = depthFormatInfo(settings.formats[i].format);
-        r.perFormat[i].format = settings.formats[i];
-        r.perFormat[i].name = depthFormatName(settings.formats[i]);
-        r.perFormat[i].bits = info.bits;
-    }
-
-    // 1. Two nearest surfaces.
-    const TwoNearest two = findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided);
+namespace {
+// 2. Per format: the fight bit (key(d1) >= key(d2), d1 <= d2: equal stored values or swapped order)
+//    and out-of-range pixels (either surface clamped by the encoder). The two-surface pixels are
+//    gathered once into a compact list that every format walks; a one-surface pixel needs no
+//    encoding when its depth is in [minValidDepth, far] (every format clamps d into [minValidDepth,
+//    hi] with hi = far or +inf, render/depth_format_impl.h), which the one-surface depths' range
+//    decides for all of them at once, per format; otherwise they are encoded one by one.
+void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &settings, ZFightResult &r) {
+    const size_t N = two.pixels(), F = settings.formats.size();
+    std::vector<uint32_t> pixel;
+    std::vector<double> near1, near2;
+    double oneMin = kInf, oneMax = -kInf;
+    bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
     for (size_t p = 0; p < N; ++p) {
-        if (two.screen1[p] != kNoFragment) ++r.coveredPixels;
-        if (two.screen2[p] != kNoFragment) ++r.twoSurfacePixels;
+        if (two.screen1[p] == kNoFragment) continue;
+        const double d1 = two.depth1[p];
+        if (two.screen2[p] != kNoFragment) {
+            pixel.push_back(uint32_t(p));
+            near1.push_back(d1);
+            near2.push_back(two.depth2[p]);
+        } else {
+            oneMin = std::min(oneMin, d1);
+            oneMax = std::max(oneMax, d1);
+            oneUnordered |= d1 != d1;
+        }
     }
-
-    // 2. Per format: the fight bit (key(d1) >= key(d2), d1 <= d2: equal stored values or swapped
-    //    order) and out-of-range pixels (either surface clamped by the encoder).
+    const size_t n2 = pixel.size();
+    std::vector<uint32_t> mask(n2, 0);
     for (size_t i = 0; i < F; ++i) {
         const DepthEncoder enc = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
         const uint32_t bit = uint32_t(1) << i;
-        uint64_t oor = 0;
-        // Shortcut for the (many) one-surface pixels, exact: every format clamps d into
-        // [minValidDepth, hi] with hi = far or +inf (render/depth_format_impl.h), so a depth in
-        // [minValidDepth, far] is never out of range and needs no encoding; others are encoded.
         const double lo = enc.minValidDepth, hi = enc.farZ;
+        const bool oneInRange = !oneUnordered && oneMin >= lo && oneMax <= hi;
+        uint64_t oor = 0;
         dispatchDepthFormat(enc.format, [&]<DepthFormat Fmt>() {
-            for (size_t p = 0; p < N; ++p) {
-                if (two.screen1[p] == kNoFragment) continue;
+            for (size_t k = 0; k < n2; ++k) {
                 uint32_t k1 = 0, k2 = 0;
                 bool o1 = false, o2 = false;
-                const double d1 = two.depth1[p];
-                if (two.screen2[p] != kNoFragment) {
-                    encodeDepth<Fmt>(enc, d1, k1, o1);
-                    encodeDepth<Fmt>(enc, two.depth2[p], k2, o2);
-                    if (k1 >= k2) r.fightMask[p] |= bit;
-                } else if (!(d1 >= lo && d1 <= hi)) {
-                    encodeDepth<Fmt>(enc, d1, k1, o1);
-                }
+                encodeDepth<Fmt>(enc, near1[k], k1, o1);
+                encodeDepth<Fmt>(enc, near2[k], k2, o2);
+                mask[k] |= k1 >= k2 ? bit : 0;
                 oor += (o1 || o2) ? 1 : 0;
+            }
+            if (oneInRange) return;
+            for (size_t p = 0; p < N; ++p) {
+                if (two.screen1[p] == kNoFragment || two.screen2[p] != kNoFragment) continue;
+                const double d1 = two.depth1[p];
+                if (d1 >= lo && d1 <= hi) continue;
+                uint32_t k1 = 0;
+                bool o1 = false;
+                encodeDepth<Fmt>(enc, d1, k1, o1);
+                oor += o1 ? 1 : 0;
             }
         });
         r.perFormat[i].outOfRangePixels = oor;
     }
+    for (size_t k = 0; k < n2; ++k) r.fightMask[pixel[k]] = mask[k];
+}
 
-    // 3. Classify the pixels that fight somewhere: shared_edge, then intersection (never for
-    //    coplanar triangles: they have no intersection line), then coplanar, else separated.
+// 3. Classify the pixels that fight somewhere: shared_edge, then intersection (never for coplanar
+//    triangles: they have no intersection line), then coplanar, else separated. Returns the smallest
+//    d2 - d1 over separated fighting pixels (for the recommendation's text).
+double classifyFights(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoNearest &two,
+                      const ZFightSettings &settings, ZFightResult &r) {
+    const int W = r.width, H = r.height;
+    const size_t F = settings.formats.size();
     PairCache pairs{scene, cam, {}};
     double minSeparatedGap = kInf;  // smallest d2 - d1 over separated fighting pixels (for the text)
     for (int y = 0; y < H; ++y)
@@ -451,8 +456,16 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
             }
         }
 
-    // 4. Hotspots: 8-connected components of separated/coplanar fighting pixels, flood-filled
-    //    from seeds in scan order (component k's seed is its first pixel in scan order).
+    return minSeparatedGap;
+}
+
+// 4. Hotspots: 8-connected components of separated/coplanar fighting pixels, flood-filled from seeds
+//    in scan order (component k's seed is its first pixel in scan order); those of at least
+//    minHotspotArea pixels, area descending, ties by seed, each explained (6.).
+void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoNearest &two,
+                  const ZFightSettings &settings, ZFightResult &r) {
+    const int W = r.width, H = r.height;
+    const size_t N = two.pixels(), F = settings.formats.size();
     auto isHotspotPixel = [&](size_t p) {
         const auto c = ZPixelClass(r.pixelClass[p]);
         return c == ZPixelClass::separated || c == ZPixelClass::coplanar;
@@ -554,7 +567,10 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     for (size_t p = 0; p < N; ++p)
         if (label[p]) r.hotspotOf[p] = idOfComp[label[p] - 1];
 
-    // 5. Recommendation: fewest bits with no non-coplanar fighting pixel; ties in settings order.
+}
+
+// 5. Recommendation: fewest bits with no non-coplanar fighting pixel; ties in settings order.
+void recommend(double minSeparatedGap, ZFightResult &r) {
     const ZFightFormatStats *best = nullptr, *leastFighting = nullptr;
     for (const ZFightFormatStats &st : r.perFormat) {
         const uint64_t genuine = st.fightingPixels - st.coplanarPixels;
@@ -577,6 +593,44 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     if (r.coplanarPixels > 0)
         r.recommendation += "; coplanar surfaces fight in every format: offset the decal or use a depth bias (" +
                             std::to_string(r.coplanarPixels) + " pixels, not counted here)";
+}
+
+}  // namespace
+
+ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const ScreenTriangles &tris,
+                              const ZFightSettings &settings) {
+    ZFightResult r;
+    if (!validate(settings, cam, &r.error)) return r;
+    const int W = std::max(cam.width, 0), H = std::max(cam.height, 0);
+    const size_t N = size_t(W) * size_t(H);
+    const size_t F = settings.formats.size();
+    r.width = W;
+    r.height = H;
+    r.nearZ = cam.nearZ;
+    r.farZ = cam.farZ;
+    r.formats = settings.formats;
+    r.pixelClass.assign(N, uint8_t(ZPixelClass::none));
+    r.fightMask.assign(N, 0);
+    r.hotspotOf.assign(N, 0);
+    r.perFormat.resize(F);
+    for (size_t i = 0; i < F; ++i) {
+        const DepthFormatInfo &info = depthFormatInfo(settings.formats[i].format);
+        r.perFormat[i].format = settings.formats[i];
+        r.perFormat[i].name = depthFormatName(settings.formats[i]);
+        r.perFormat[i].bits = info.bits;
+    }
+
+    // 1. Two nearest surfaces.
+    const TwoNearest two = findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided);
+    for (size_t p = 0; p < N; ++p) {
+        if (two.screen1[p] != kNoFragment) ++r.coveredPixels;
+        if (two.screen2[p] != kNoFragment) ++r.twoSurfacePixels;
+    }
+
+    markFights(two, cam, settings, r);
+    const double minSeparatedGap = classifyFights(scene, cam, tris, two, settings, r);
+    findHotspots(scene, cam, tris, two, settings, r);
+    recommend(minSeparatedGap, r);
     return r;
 }
 
