@@ -50,6 +50,7 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
     }
     double lo, hi;
     depthRange(ref.depth, &lo, &hi);
+    const DepthGrayScale gray(lo, hi);
     std::vector<uint8_t> img(n * 3);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -57,7 +58,7 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
             const uint8_t f = audit.fate[i];
             Rgb8 c{0, 0, 0};
             if (f == kFateDrawn) {
-                const uint8_t g = depthGray(ref.depth[i], lo, hi);
+                const uint8_t g = gray(ref.depth[i]);
                 c = {uint8_t(g * kCullDrawnTint.r / 255), uint8_t(g * kCullDrawnTint.g / 255),
                      uint8_t(g * kCullDrawnTint.b / 255)};
             } else if (f == kFateUnaccounted) {
@@ -97,12 +98,13 @@ bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std
     }
     double lo, hi;
     depthRange(zb.depth, &lo, &hi);
+    const DepthGrayScale gray(lo, hi);
     std::vector<uint8_t> img(n * 3);
     for (size_t i = 0; i < n; ++i) {
         const Disagreement d = Disagreement(check.cls[i]);
         Rgb8 c;
         if (d == Disagreement::none) {
-            const uint8_t g = uint8_t(depthGray(zb.depth[i], lo, hi) / 4);  // dimmed: the classes stand out
+            const uint8_t g = uint8_t(gray(zb.depth[i]) / 4);  // dimmed: the classes stand out
             c = {g, g, g};
         } else {
             c = disagreementColor(d);

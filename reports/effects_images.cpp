@@ -30,6 +30,7 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
     const int W = zb.width, H = zb.height;
     double lo, hi;
     depthRange(zb.depth, &lo, &hi);
+    const DepthGrayScale gray(lo, hi);
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     // A visible pixel is lit, shadowed or facing away; the ray caster's visibility decides which
     // pixels are visible, so lit = visible and neither of the other two.
@@ -41,7 +42,7 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
             if (fx.shadowed(light, x, y)) {
                 c = kShadowed;
             } else {
-                const uint8_t g = depthGray(zb.depth[i], lo, hi);
+                const uint8_t g = gray(zb.depth[i]);
                 c = {g, g, g};
             }
             img[3 * i] = c.r, img[3 * i + 1] = c.g, img[3 * i + 2] = c.b;
@@ -61,6 +62,7 @@ bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::
     const int W = zb.width, H = zb.height;
     double lo, hi;
     depthRange(zb.depth, &lo, &hi);
+    const DepthGrayScale gray(lo, hi);
     // Depth 1..8+ on the overdraw ramp; 0 (no secondary ray) shows the depth image dimmed.
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     int deepest = 0;
@@ -71,7 +73,7 @@ bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::
         if (k > 0) {
             c = overdrawColor(uint32_t(k), 8);
         } else {
-            const uint8_t g = uint8_t(depthGray(zb.depth[i], lo, hi) / 3);
+            const uint8_t g = uint8_t(gray(zb.depth[i]) / 3);
             c = {g, g, g};
         }
         img[3 * i] = c.r, img[3 * i + 1] = c.g, img[3 * i + 2] = c.b;

@@ -192,28 +192,6 @@ void depthRange(const std::vector<double> &depth, double *dMin, double *dMax) {
         }
 }
 
-namespace {
-// depthGray for one view's range, with the range's logarithms taken once rather than per pixel
-// (the same operations on the same values, so the same grays).
-struct DepthGrayScale {
-    bool valid, spread;
-    double logMin = 0, logSpan = 0;
-    DepthGrayScale(double dMin, double dMax) : valid(dMin > 0 && std::isfinite(dMax)), spread(dMax > dMin) {
-        if (valid && spread) {
-            logMin = std::log(dMin);
-            logSpan = std::log(dMax) - logMin;
-        }
-    }
-    uint8_t operator()(double d) const {
-        if (!std::isfinite(d) || !(d > 0) || !valid) return 0;
-        double t = 0;
-        if (spread) t = (std::log(d) - logMin) / logSpan;
-        t = std::clamp(t, 0.0, 1.0);
-        return uint8_t(std::lround(255.0 - t * (255.0 - kDepthPngFarGray)));
-    }
-};
-}  // namespace
-
 uint8_t depthGray(double d, double dMin, double dMax) { return DepthGrayScale(dMin, dMax)(d); }
 
 // ---- Writing ----------------------------------------------------------------------------------

@@ -39,6 +39,7 @@ std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const P
     double lo = INFINITY, hi = -INFINITY;
     for (double d : ref.depth)
         if (std::isfinite(d) && d > 0) lo = std::min(lo, d), hi = std::max(hi, d);
+    const DepthGrayScale gray(lo, hi);
     const int scale = W >= 1024 ? 2 : 1;
     const int strip = 13 * scale;
     *canvasH = H + strip;
@@ -49,7 +50,7 @@ std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const P
         else if (painter.cls[i] == kOrderTie) c = kOrderTieColor;
         else if (painter.cls[i] == kOrderEdge) c = kOrderEdgeColor;
         else if (ref.id[i]) {
-            const uint8_t g = uint8_t(depthGray(ref.depth[i], lo, hi) / 2);
+            const uint8_t g = uint8_t(gray(ref.depth[i]) / 2);
             c = {g, g, g};
         }
         uint8_t *p = &rgb[i * 3];

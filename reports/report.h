@@ -1,6 +1,8 @@
 // Report outputs: report.json (docs/report-schema.json) and the per-view images.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -116,6 +118,25 @@ Rgb8 overdrawColor(uint32_t fragments, uint32_t cap);
 // maximum finite depth): dMin -> 255 (white), dMax -> kDepthPngFarGray, background -> 0.
 constexpr uint8_t kDepthPngFarGray = 40;
 uint8_t depthGray(double d, double dMin, double dMax);
+// depthGray for one view's range, with the range's logarithms taken once rather than per pixel
+// (the same operations on the same values, so the same grays): what an image's loop uses.
+struct DepthGrayScale {
+    bool valid, spread;
+    double logMin = 0, logSpan = 0;
+    DepthGrayScale(double dMin, double dMax) : valid(dMin > 0 && std::isfinite(dMax)), spread(dMax > dMin) {
+        if (valid && spread) {
+            logMin = std::log(dMin);
+            logSpan = std::log(dMax) - logMin;
+        }
+    }
+    uint8_t operator()(double d) const {
+        if (!std::isfinite(d) || !(d > 0) || !valid) return 0;
+        double t = 0;
+        if (spread) t = (std::log(d) - logMin) / logSpan;
+        t = std::clamp(t, 0.0, 1.0);
+        return uint8_t(std::lround(255.0 - t * (255.0 - kDepthPngFarGray)));
+    }
+};
 // The nearest and farthest finite positive depth of a view (depthGray's range): +inf / -inf when
 // nothing is drawn.
 void depthRange(const std::vector<double> &depth, double *dMin, double *dMax);

@@ -103,10 +103,11 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     // 1. Dimmed gray view; 2. markers.
     double dMin, dMax;
     depthRange(zb.depth, &dMin, &dMax);
+    const DepthGrayScale gray(dMin, dMax);
     for (int y = 0; y < H; ++y)
         for (int xx = 0; xx < W; ++xx) {
             const size_t p = size_t(y) * size_t(W) + size_t(xx);
-            const uint8_t g = uint8_t(depthGray(zb.depth[p], dMin, dMax) / 2);
+            const uint8_t g = uint8_t(gray(zb.depth[p]) / 2);
             Rgb8 col{g, g, g};
             const auto cls = ZPixelClass(zf.pixelClass[p]);
             if (cls == ZPixelClass::shared_edge) col = kZFightSharedEdgeColor;
