@@ -134,7 +134,9 @@ struct DepthGrayScale {
         double t = 0;
         if (spread) t = (std::log(d) - logMin) / logSpan;
         t = std::clamp(t, 0.0, 1.0);
-        return uint8_t(std::lround(255.0 - t * (255.0 - kDepthPngFarGray)));
+        // lround(x) for x in [kDepthPngFarGray, 255]: x + 0.5 is exact there, or rounds only where
+        // it reaches a new power of two (64, 128, 256), whose floor is then already x's rounding.
+        return uint8_t(255.0 - t * (255.0 - kDepthPngFarGray) + 0.5);
     }
 };
 // The nearest and farthest finite positive depth of a view (depthGray's range): +inf / -inf when

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <ctime>
@@ -825,6 +826,32 @@ TEST(ReportConsole, WideNumbersAndNonFinite) {
     const std::string t = funnelTable(v);
     EXPECT_NE(t.find("  frustum    ran     123456789012           1 123456789011    1234.6\n"), std::string::npos) << t;
     EXPECT_NE(t.find("overdraw n/a, depth complexity 1.75 (max 2)"), std::string::npos) << t;
+}
+
+// DepthGrayScale rounds with x + 0.5 instead of calling lround: the same gray for every depth. The
+// values where the two could part are the half-integers x = k + 0.5 and their neighbours; each is
+// reached through the depth that lands on it (and the doubles around that depth), plus a sweep.
+TEST(DepthGray, RoundsAsLroundDoes) {
+    const double dMin = 0.37, dMax = 4211.5;
+    const DepthGrayScale gray(dMin, dMax);
+    const double logMin = std::log(dMin), logSpan = std::log(dMax) - logMin;
+    auto reference = [&](double d) {
+        const double t = std::clamp((std::log(d) - logMin) / logSpan, 0.0, 1.0);
+        return uint8_t(std::lround(255.0 - t * (255.0 - kDepthPngFarGray)));
+    };
+    uint64_t checked = 0;
+    for (int k = kDepthPngFarGray; k < 255; ++k) {
+        const double t = (255.0 - (k + 0.5)) / (255.0 - kDepthPngFarGray);
+        double d = std::exp(logMin + t * logSpan);
+        for (int step = 0; step < 64; ++step) d = std::nextafter(d, 0.0);
+        for (int step = 0; step < 128; ++step, d = std::nextafter(d, INFINITY), ++checked)
+            ASSERT_EQ(gray(d), reference(d)) << "depth " << d;
+    }
+    for (double d = dMin; d <= dMax; d *= 1.0001, ++checked) ASSERT_EQ(gray(d), reference(d)) << "depth " << d;
+    EXPECT_EQ(gray(dMin), 255);
+    EXPECT_EQ(gray(dMax), kDepthPngFarGray);
+    EXPECT_EQ(gray(INFINITY), 0);
+    EXPECT_GT(checked, 100000u);
 }
 
 }  // namespace
