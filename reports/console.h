@@ -2,6 +2,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "analysis/results.h"
 
@@ -19,5 +22,14 @@ namespace va {
 // Counts are right-aligned in 11 columns (wider numbers push the row, never truncate), ms have one
 // decimal, ratios two ("n/a" when not finite). Every line ends with '\n'.
 std::string funnelTable(const ViewResult &view);
+
+// visaudit info: a scene's summary (triangles, faces, objects, bounds, up axis, materials, lights,
+// views) as aligned text, and the same fields as JSON (info --json).
+std::string sceneSummaryTable(const Scene &scene, const std::vector<ViewSpec> &views);
+nlohmann::ordered_json sceneSummaryJson(const Scene &scene, const std::vector<ViewSpec> &views);
+
+// depth-audit --scene: per view, each format's fighting pixels (coplanar ones in brackets), the
+// recommended format, the three largest hotspots and why they fight.
+std::string zfightViewsTable(const std::string &scenePath, const AnalysisResult &result);
 
 }  // namespace va
