@@ -2,7 +2,7 @@
 //
 // The page is generated from report.json alone (plus the image files next to it), so analyze,
 // merge and check all write the same page for the same report. It needs nothing but a browser:
-// CSS and JavaScript are inline (reports/html_assets.h), charts are inline SVG, images are
+// CSS and JavaScript are inline (reports/assets/, embedded by CMakeLists.txt), charts are inline SVG, images are
 // relative links to the PNGs in the same folder; no fonts, no CDN, no network.
 //
 // Every section is optional: a view without `audit`, `depth`, `raycast`, `effects`, `ordering`,
