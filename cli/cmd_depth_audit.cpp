@@ -26,6 +26,8 @@ struct DepthAuditOptions : SceneOptions {
     int threads = 0;
 };
 
+// depth-audit --scene: the per-view z-fighting analysis over a scene's views, with the formats'
+// verdicts and the recommendation per view (no images, no report folder).
 int depthAuditScene(const DepthAuditOptions &o, const std::vector<DepthFormatSpec> &formats) {
     installInterruptHandlers();
     Scene scene;

@@ -54,8 +54,6 @@ void addMergeOptions(CLI::App *c, MergeOptions &o) {
     addJsonDepthOption(c, o.maxJsonDepth);
 }
 
-// depth-audit --scene: the per-view z-fighting analysis over a scene's views, with the formats'
-
 }  // namespace
 
 CommandRun setupMerge(CLI::App *c) { return bindCommand<MergeOptions>(c, addMergeOptions, cmdMerge); }

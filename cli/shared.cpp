@@ -114,9 +114,6 @@ bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *view
     return true;
 }
 
-// "a,b,log24:C=0.01" or "all" into depth formats (in the order given); false + message on an
-
-// unknown or repeated name.
 bool parseDepthFormatList(const std::string &list, std::vector<DepthFormatSpec> *out, std::string *err) {
     std::vector<DepthFormatSpec> formats;
     if (list == "all") {
