@@ -254,22 +254,11 @@ double msBetween(std::chrono::steady_clock::time_point a, std::chrono::steady_cl
 
 // ---- One cluster --------------------------------------------------------------------------------
 
-void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *out) {
-    using Clock = std::chrono::steady_clock;
+// a. Eye points in cluster c (its leafs lb..le of cx.clusterLeafs), drawn by box volume (all
+// equally when every box is flat), outside other clusters and solid brushes.
+void sampleEyes(const Context &cx, int32_t c, uint32_t lb, uint32_t le, SplitMix64 &rng, Scratch &sc,
+                PvsClusterAudit &r) {
     const BspLevel &lv = cx.lv;
-    PvsClusterAudit &r = *out;
-    r.cluster = c;
-    const uint32_t lb = cx.clusterLeafsBegin[size_t(c)], le = cx.clusterLeafsBegin[size_t(c) + 1];
-    r.leafs = le - lb;
-    for (uint32_t k = lb; k < le; ++k) r.bounds.extend(lv.leafs[cx.clusterLeafs[k]].bounds);
-    // The PVS row.
-    for (int32_t t = 0; t < lv.clusterCount; ++t) r.pvsVisible += cx.pvsBit(c, t);
-    // Each cluster's own sequence: the seed and the cluster mixed through splitmix64.
-    SplitMix64 rng{cx.s.seed ^ (0x9E3779B97F4A7C15ull * (uint64_t(c) + 1))};
-    rng.next();
-
-    // a. Eye points. Leafs drawn by box volume (all equally when every box is flat).
-    const auto t0 = Clock::now();
     sc.weights.clear();
     double total = 0;
     for (uint32_t k = lb; k < le; ++k) {
@@ -305,12 +294,14 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
         r.playerSamples += r.playerEye.back();
     }
     r.samples = uint32_t(r.eyes.size());
-    const auto t1 = Clock::now();
-    sc.sampleMs += msBetween(t0, t1);
-    if (r.samples == 0) return;
+}
 
-    // b. Rays. flag[t]: kWithin = seen within the far plane, kBeyond = seen beyond it, kPlayer =
-    // seen within it from an eye point where a player's eye can be.
+// b. Rays from every eye point. flag[t]: kWithin = seen within the far plane, kBeyond = seen beyond
+// it, kPlayer = seen within it from an eye point where a player's eye can be; a hidden cluster's
+// evidence is kept in sc.misses.
+void castRays(const Context &cx, int32_t c, SplitMix64 &rng, Scratch &sc, PvsClusterAudit &r) {
+    using Clock = std::chrono::steady_clock;
+    const BspLevel &lv = cx.lv;
     sc.touched.clear();
     sc.misses.clear();
     auto touch = [&](int32_t t) {
@@ -409,7 +400,11 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
         sc.walkMs += msBetween(c1, Clock::now());
     }
 
-    // c. The row against what was seen; the scratch cleared for the next cluster.
+}
+
+// c. The row against what was seen; the scratch cleared for the next cluster.
+void compareRow(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit &r) {
+    const BspLevel &lv = cx.lv;
     std::sort(sc.touched.begin(), sc.touched.end());
     uint32_t seenVisible = 0;  // seen clusters whose bit is set
     for (int32_t t : sc.touched) {
@@ -434,6 +429,27 @@ void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *ou
         sc.flag[size_t(t)] = 0, sc.rays[size_t(t)] = 0, sc.lastRay[size_t(t)] = 0, sc.evidence[size_t(t)] = -1;
     }
     r.slack = r.pvsVisible - seenVisible;  // visible in the row, never seen
+}
+
+void auditCluster(const Context &cx, int32_t c, Scratch &sc, PvsClusterAudit *out) {
+    using Clock = std::chrono::steady_clock;
+    const BspLevel &lv = cx.lv;
+    PvsClusterAudit &r = *out;
+    r.cluster = c;
+    const uint32_t lb = cx.clusterLeafsBegin[size_t(c)], le = cx.clusterLeafsBegin[size_t(c) + 1];
+    r.leafs = le - lb;
+    for (uint32_t k = lb; k < le; ++k) r.bounds.extend(lv.leafs[cx.clusterLeafs[k]].bounds);
+    // The PVS row.
+    for (int32_t t = 0; t < lv.clusterCount; ++t) r.pvsVisible += cx.pvsBit(c, t);
+    // Each cluster's own sequence: the seed and the cluster mixed through splitmix64.
+    SplitMix64 rng{cx.s.seed ^ (0x9E3779B97F4A7C15ull * (uint64_t(c) + 1))};
+    rng.next();
+    const auto t0 = Clock::now();
+    sampleEyes(cx, c, lb, le, rng, sc, r);
+    sc.sampleMs += msBetween(t0, Clock::now());
+    if (r.samples == 0) return;
+    castRays(cx, c, rng, sc, r);
+    compareRow(cx, c, sc, r);
 }
 
 // ---- Top-down view ------------------------------------------------------------------------------
@@ -528,6 +544,146 @@ void walkBspSegment(const BspLevel &level, Vec3 eye, Vec3 dir, double tEnd,
     walk(nodes, at.data(), level.leafs.empty(), dir, tEnd, stack, leaf);
 }
 
+namespace {
+// The leafs of each cluster the world's tree reaches (CSR in cx.clusterLeafs), and the box of the
+// scene and those leafs.
+void indexClusterLeafs(const Scene &scene, const BspLevel &lv, Context &cx, Aabb *boxOut) {
+    // The leafs the world's tree reaches (a brush model's own leafs are not in it): nodes are in
+    // pre-order, so one pass marks every reachable node and leaf.
+    std::vector<uint8_t> inTree(lv.leafs.size(), 0);
+    if (lv.nodes.empty()) {
+        if (!lv.leafs.empty()) inTree[0] = 1;
+    } else {
+        std::vector<uint8_t> nodeIn(lv.nodes.size(), 0);
+        nodeIn[0] = 1;
+        for (size_t i = 0; i < lv.nodes.size(); ++i)
+            if (nodeIn[i])
+                for (int32_t ch : lv.nodes[i].children) {
+                    if (ch >= 0) nodeIn[size_t(ch)] = 1;
+                    else inTree[size_t(-(int64_t(ch) + 1))] = 1;
+                }
+    }
+    cx.clusterLeafsBegin.assign(size_t(lv.clusterCount) + 1, 0);
+    Aabb box = scene.bounds;
+    for (size_t l = 0; l < lv.leafs.size(); ++l)
+        if (inTree[l] && lv.leafs[l].cluster >= 0) {
+            ++cx.clusterLeafsBegin[size_t(lv.leafs[l].cluster) + 1];
+            box.extend(lv.leafs[l].bounds);
+        }
+    for (size_t c = 0; c < size_t(lv.clusterCount); ++c) cx.clusterLeafsBegin[c + 1] += cx.clusterLeafsBegin[c];
+    cx.clusterLeafs.resize(cx.clusterLeafsBegin.back());
+    {
+        std::vector<uint32_t> fill(cx.clusterLeafsBegin.begin(), cx.clusterLeafsBegin.end() - 1);
+        for (size_t l = 0; l < lv.leafs.size(); ++l)
+            if (inTree[l] && lv.leafs[l].cluster >= 0) cx.clusterLeafs[fill[size_t(lv.leafs[l].cluster)]++] = uint32_t(l);
+    }
+    *boxOut = box;
+}
+
+// The triangles the rays stop at; the others counted in `occluders`.
+std::vector<uint32_t> opaqueTriangles(const Scene &scene, const BspLevel &lv, PvsOccluders *occluders) {
+    // The opaque triangles: drawn world faces without CONTENTS_TRANSLUCENT (the loader has already
+    // left out sky, tool surfaces and see-through liquids). A scene whose triangles cannot be traced
+    // to faces (no triangleFace) treats every triangle as opaque world geometry.
+    std::vector<uint32_t> opaque;
+    const bool faces = lv.triangleFace.size() == scene.triangleCount();
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+        if (scene.triangleObject[t] == kExcludedTriangle) continue;
+        if (faces) {
+            const uint32_t f = lv.triangleFace[t];
+            if (f < lv.worldFirstFace || f - lv.worldFirstFace >= lv.worldFaceCount) {
+                ++occluders->entity;
+                continue;
+            }
+            if (f < lv.faceShader.size() && lv.faceShader[f] < lv.shaders.size() &&
+                (lv.shaders[lv.faceShader[f]].contents & kContentsTranslucent)) {
+                ++occluders->translucent;
+                continue;
+            }
+        }
+        opaque.push_back(uint32_t(t));
+    }
+    occluders->opaque = opaque.size();
+    return opaque;
+}
+
+// 2. Every cluster of `todo`, in parallel; each result goes to its own slot of res.clusters. False
+// when s.cancel stopped it.
+bool auditClusters(const Context &cx, const BspLevel &lv, const PvsAuditSettings &s, const std::vector<int32_t> &todo,
+                   PvsAuditResult &res) {
+    res.clusters.resize(todo.size());
+    std::atomic<size_t> done{0};
+    std::atomic<bool> stopped{false};
+    struct ThreadTimes {
+        double sample = 0, cast = 0, walk = 0;
+    };
+    std::vector<ThreadTimes> perCluster(todo.size());
+    tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
+        if (stopped.load(std::memory_order_relaxed)) return;
+        if (s.cancel && s.cancel->load(std::memory_order_relaxed)) {
+            stopped = true;
+            return;
+        }
+        thread_local std::unique_ptr<Scratch> scratch;
+        if (!scratch) scratch = std::make_unique<Scratch>();
+        Scratch &sc = *scratch;
+        if (sc.flag.size() != size_t(lv.clusterCount)) {
+            sc.flag.assign(size_t(lv.clusterCount), 0);
+            sc.rays.assign(size_t(lv.clusterCount), 0);
+            sc.lastRay.assign(size_t(lv.clusterCount), 0);
+            sc.evidence.assign(size_t(lv.clusterCount), -1);
+        }
+        sc.sampleMs = sc.castMs = sc.walkMs = 0;
+        auditCluster(cx, todo[i], sc, &res.clusters[i]);
+        perCluster[i] = {sc.sampleMs, sc.castMs, sc.walkMs};
+        const size_t k = ++done;
+        if (s.progress) s.progress(k, todo.size());
+    });
+    if (stopped) return false;
+    if (!Stopwatch::fixedTimings())
+        for (const ThreadTimes &t : perCluster) {
+            res.sampleThreadMs += t.sample;
+            res.castThreadMs += t.cast;
+            res.walkThreadMs += t.walk;
+        }
+    return true;
+}
+
+// 3. Totals and histograms, in cluster order.
+void sumClusters(int32_t clusterCount, size_t requested, PvsAuditResult &res) {
+    PvsAuditTotals &T = res.totals;
+    T.clusters = uint32_t(clusterCount);
+    T.requested = uint32_t(requested);
+    res.slackHistogram.assign(10, 0);
+    res.missHistogram.assign(7, 0);
+    for (const PvsClusterAudit &c : res.clusters) {
+        T.samples += c.samples;
+        T.rays += c.rays;
+        if (c.samples == 0) {
+            ++T.unsampled;
+            continue;
+        }
+        ++T.audited;
+        T.pvsVisiblePairs += c.pvsVisible;
+        T.seenPairs += c.seen;
+        T.misses += c.misses;
+        T.missClusters += c.misses > 0;
+        T.crackMisses += c.crackMisses;
+        T.playerClusters += c.playerSamples > 0;
+        T.slackPairs += c.slack;
+        T.seenBeyondFarPairs += c.seenBeyondFar;
+        T.hiddenByFarPlanePairs += c.hiddenByFarPlane;
+        ++res.slackHistogram[std::min<size_t>(9, size_t(c.slackShare() * 10))];
+        size_t bin = 0;
+        for (uint32_t m = c.misses; m > 0 && bin < 6; m >>= 1) ++bin;  // 0, 1, 2-3, 4-7, ..., 32+
+        ++res.missHistogram[bin];
+    }
+    T.slackShare = T.pvsVisiblePairs ? double(T.slackPairs) / double(T.pvsVisiblePairs) : 0.0;
+
+}
+
+}  // namespace
+
 bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out, std::string *err) {
     if (const char *why = pvsAuditSkipReason(scene)) {
         *err = scene.path + ": " + why;
@@ -558,35 +714,8 @@ bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out
     // 1. Setup.
     const Stopwatch setup;
     Context cx(scene, res.settings);
-    // The leafs the world's tree reaches (a brush model's own leafs are not in it): nodes are in
-    // pre-order, so one pass marks every reachable node and leaf.
-    std::vector<uint8_t> inTree(lv.leafs.size(), 0);
-    if (lv.nodes.empty()) {
-        if (!lv.leafs.empty()) inTree[0] = 1;
-    } else {
-        std::vector<uint8_t> nodeIn(lv.nodes.size(), 0);
-        nodeIn[0] = 1;
-        for (size_t i = 0; i < lv.nodes.size(); ++i)
-            if (nodeIn[i])
-                for (int32_t ch : lv.nodes[i].children) {
-                    if (ch >= 0) nodeIn[size_t(ch)] = 1;
-                    else inTree[size_t(-(int64_t(ch) + 1))] = 1;
-                }
-    }
-    cx.clusterLeafsBegin.assign(size_t(lv.clusterCount) + 1, 0);
-    Aabb box = scene.bounds;
-    for (size_t l = 0; l < lv.leafs.size(); ++l)
-        if (inTree[l] && lv.leafs[l].cluster >= 0) {
-            ++cx.clusterLeafsBegin[size_t(lv.leafs[l].cluster) + 1];
-            box.extend(lv.leafs[l].bounds);
-        }
-    for (size_t c = 0; c < size_t(lv.clusterCount); ++c) cx.clusterLeafsBegin[c + 1] += cx.clusterLeafsBegin[c];
-    cx.clusterLeafs.resize(cx.clusterLeafsBegin.back());
-    {
-        std::vector<uint32_t> fill(cx.clusterLeafsBegin.begin(), cx.clusterLeafsBegin.end() - 1);
-        for (size_t l = 0; l < lv.leafs.size(); ++l)
-            if (inTree[l] && lv.leafs[l].cluster >= 0) cx.clusterLeafs[fill[size_t(lv.leafs[l].cluster)]++] = uint32_t(l);
-    }
+    Aabb box;
+    indexClusterLeafs(scene, lv, cx, &box);
     if (box.empty()) box.extend(Vec3{0, 0, 0});
     cx.origin = box.center();
     // Every ray starts inside the box, so it leaves it within the diagonal (+1: the eye may lie on it).
@@ -611,28 +740,7 @@ bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out
         res.farPlaneText = text;
     }
     res.farPlane = cx.farPlane;
-    // The opaque triangles: drawn world faces without CONTENTS_TRANSLUCENT (the loader has already
-    // left out sky, tool surfaces and see-through liquids). A scene whose triangles cannot be traced
-    // to faces (no triangleFace) treats every triangle as opaque world geometry.
-    std::vector<uint32_t> opaque;
-    const bool faces = lv.triangleFace.size() == scene.triangleCount();
-    for (size_t t = 0; t < scene.triangleCount(); ++t) {
-        if (scene.triangleObject[t] == kExcludedTriangle) continue;
-        if (faces) {
-            const uint32_t f = lv.triangleFace[t];
-            if (f < lv.worldFirstFace || f - lv.worldFirstFace >= lv.worldFaceCount) {
-                ++res.occluders.entity;
-                continue;
-            }
-            if (f < lv.faceShader.size() && lv.faceShader[f] < lv.shaders.size() &&
-                (lv.shaders[lv.faceShader[f]].contents & kContentsTranslucent)) {
-                ++res.occluders.translucent;
-                continue;
-            }
-        }
-        opaque.push_back(uint32_t(t));
-    }
-    res.occluders.opaque = opaque.size();
+    const std::vector<uint32_t> opaque = opaqueTriangles(scene, lv, &res.occluders);
     if (!cx.rays.build(MeshView{scene.positions.data(), scene.indices.data()}, scene.positions.size(), opaque,
                        cx.origin, err))
         return false;
@@ -644,78 +752,15 @@ bool auditPvs(const Scene &scene, const PvsAuditSettings &s, PvsAuditResult *out
         for (int32_t c = 0; c < lv.clusterCount; ++c) todo.push_back(c);
     res.setupMs = setup.ms();
 
-    // 2. Every cluster, in parallel; each result goes to its own slot.
+    // 2. Every cluster, in parallel.
     const Stopwatch audit;
-    res.clusters.resize(todo.size());
-    std::atomic<size_t> done{0};
-    std::atomic<bool> stopped{false};
-    struct ThreadTimes {
-        double sample = 0, cast = 0, walk = 0;
-    };
-    std::vector<ThreadTimes> perCluster(todo.size());
-    tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
-        if (stopped.load(std::memory_order_relaxed)) return;
-        if (s.cancel && s.cancel->load(std::memory_order_relaxed)) {
-            stopped = true;
-            return;
-        }
-        thread_local std::unique_ptr<Scratch> scratch;
-        if (!scratch) scratch = std::make_unique<Scratch>();
-        Scratch &sc = *scratch;
-        if (sc.flag.size() != size_t(lv.clusterCount)) {
-            sc.flag.assign(size_t(lv.clusterCount), 0);
-            sc.rays.assign(size_t(lv.clusterCount), 0);
-            sc.lastRay.assign(size_t(lv.clusterCount), 0);
-            sc.evidence.assign(size_t(lv.clusterCount), -1);
-        }
-        sc.sampleMs = sc.castMs = sc.walkMs = 0;
-        auditCluster(cx, todo[i], sc, &res.clusters[i]);
-        perCluster[i] = {sc.sampleMs, sc.castMs, sc.walkMs};
-        const size_t k = ++done;
-        if (s.progress) s.progress(k, todo.size());
-    });
-    if (stopped) {
+    if (!auditClusters(cx, lv, s, todo, res)) {
         *err = "interrupted";
         return false;
     }
     res.auditMs = audit.ms();
-    if (!Stopwatch::fixedTimings())
-        for (const ThreadTimes &t : perCluster) {
-            res.sampleThreadMs += t.sample;
-            res.castThreadMs += t.cast;
-            res.walkThreadMs += t.walk;
-        }
 
-    // 3. Totals and histograms, in cluster order.
-    PvsAuditTotals &T = res.totals;
-    T.clusters = uint32_t(lv.clusterCount);
-    T.requested = uint32_t(todo.size());
-    res.slackHistogram.assign(10, 0);
-    res.missHistogram.assign(7, 0);
-    for (const PvsClusterAudit &c : res.clusters) {
-        T.samples += c.samples;
-        T.rays += c.rays;
-        if (c.samples == 0) {
-            ++T.unsampled;
-            continue;
-        }
-        ++T.audited;
-        T.pvsVisiblePairs += c.pvsVisible;
-        T.seenPairs += c.seen;
-        T.misses += c.misses;
-        T.missClusters += c.misses > 0;
-        T.crackMisses += c.crackMisses;
-        T.playerClusters += c.playerSamples > 0;
-        T.slackPairs += c.slack;
-        T.seenBeyondFarPairs += c.seenBeyondFar;
-        T.hiddenByFarPlanePairs += c.hiddenByFarPlane;
-        ++res.slackHistogram[std::min<size_t>(9, size_t(c.slackShare() * 10))];
-        size_t bin = 0;
-        for (uint32_t m = c.misses; m > 0 && bin < 6; m >>= 1) ++bin;  // 0, 1, 2-3, 4-7, ..., 32+
-        ++res.missHistogram[bin];
-    }
-    T.slackShare = T.pvsVisiblePairs ? double(T.slackPairs) / double(T.pvsVisiblePairs) : 0.0;
-
+    sumClusters(lv.clusterCount, todo.size(), res);
     const Stopwatch top;
     topView(cx, box, s.imageSize, &res.top);
     res.topViewMs = top.ms();
