@@ -64,6 +64,69 @@ bool fail(std::string *err, const std::string &m) {
 
 }  // namespace
 
+namespace {
+// 1. A source object's triangles (ids tri..): non-finite and degenerate ones counted and left out,
+// the others' planes computed and listed in `items` for chunking.
+bool classifyTriangles(const SceneBuildInput::Object &o, uint64_t tri, Scene &s, std::vector<ChunkItem> &items,
+                       std::string *err) {
+    const RawMesh &g = o.geometry;
+    const uint32_t triangleCount = uint32_t(g.indices.size() / 3);
+    items.clear();
+    const size_t nv = g.positions.size();
+    for (uint32_t t = 0; t < triangleCount; ++t) {
+        const uint32_t i0 = g.indices[3 * t], i1 = g.indices[3 * t + 1], i2 = g.indices[3 * t + 2];
+        if (i0 >= nv || i1 >= nv || i2 >= nv)
+            return fail(err, "object '" + o.name + "': triangle " + std::to_string(t) +
+                                 " has a vertex index outside its " + std::to_string(nv) +
+                                 " positions (internal error in the loader)");
+        const Vec3 v0 = g.positions[i0], v1 = g.positions[i1], v2 = g.positions[i2];
+        const uint64_t id = tri + t;
+        if (!isFinite(v0) || !isFinite(v1) || !isFinite(v2)) {
+            ++s.stats.nonFiniteTriangles;
+            continue;
+        }
+        // Zero area, decided exactly as far as double allows: equal vertices, or a cross product
+        // that is exactly zero (collinear, or so thin that every component underflows).
+        const Vec3 n = cross(v1 - v0, v2 - v0);
+        if (v0 == v1 || v1 == v2 || v0 == v2 || (n.x == 0 && n.y == 0 && n.z == 0)) {
+            ++s.stats.degenerateTriangles;
+            continue;
+        }
+        // Finite coordinates can still overflow the cross product (|coordinates| > ~1e154); such a
+        // plane is not representable, so the triangle is counted as non-finite.
+        const double k = -dot(n, v0);
+        if (!isFinite(n) || !std::isfinite(k)) {
+            ++s.stats.nonFiniteTriangles;
+            continue;
+        }
+        double *p = &s.planes[4 * id];
+        p[0] = n.x, p[1] = n.y, p[2] = n.z, p[3] = k;
+        s.planeBounds[2 * id] = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
+        s.planeBounds[2 * id + 1] = std::fmax(maxAbs(v0), std::fmax(maxAbs(v1), maxAbs(v2)));
+        items.push_back({v0 + v1 + v2, uint32_t(id)});
+    }
+
+    return true;
+}
+
+// Conservative bounding sphere: center = AABB center, radius = the largest computed distance to a
+// vertex, rounded up. A computed dot(d, d) has at most 5 rounded operations along any path
+// (subtraction, square, two additions; all terms are >= 0), so it is within a relative gamma(5) of the
+// true squared distance; the sqrt halves that and adds half an ulp, leaving the distance within a
+// relative gamma(4). Scaling by (1 + gamma(6)) (itself rounded by at most half an ulp, covered by the
+// slack) makes the radius an upper bound.
+void boundingSphere(const Scene &s, SceneObject &so) {
+    so.sphere.center = so.bounds.center();
+    double r2 = 0;
+    for (uint32_t v = so.vertexBegin; v < so.vertexEnd; ++v) {
+        const Vec3 d = s.positions[v] - so.sphere.center;
+        r2 = std::max(r2, dot(d, d));
+    }
+    so.sphere.radius = std::sqrt(r2) * (1 + gamma(6));
+}
+
+}  // namespace
+
 bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *outScene, std::string *err) {
     Scene s;
     s.path = std::move(in.path);
@@ -117,40 +180,8 @@ bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *outSce
         for (const auto &w : g.warnings) s.warnings.push_back(w);
 
         // 1. Classify and compute planes.
-        items.clear();
+        if (!classifyTriangles(o, tri, s, items, err)) return false;
         const size_t nv = g.positions.size();
-        for (uint32_t t = 0; t < src.triangleCount; ++t) {
-            const uint32_t i0 = g.indices[3 * t], i1 = g.indices[3 * t + 1], i2 = g.indices[3 * t + 2];
-            if (i0 >= nv || i1 >= nv || i2 >= nv)
-                return fail(err, "object '" + o.name + "': triangle " + std::to_string(t) +
-                                     " has a vertex index outside its " + std::to_string(nv) +
-                                     " positions (internal error in the loader)");
-            const Vec3 v0 = g.positions[i0], v1 = g.positions[i1], v2 = g.positions[i2];
-            const uint64_t id = tri + t;
-            if (!isFinite(v0) || !isFinite(v1) || !isFinite(v2)) {
-                ++s.stats.nonFiniteTriangles;
-                continue;
-            }
-            // Zero area, decided exactly as far as double allows: equal vertices, or a cross product
-            // that is exactly zero (collinear, or so thin that every component underflows).
-            const Vec3 n = cross(v1 - v0, v2 - v0);
-            if (v0 == v1 || v1 == v2 || v0 == v2 || (n.x == 0 && n.y == 0 && n.z == 0)) {
-                ++s.stats.degenerateTriangles;
-                continue;
-            }
-            // Finite coordinates can still overflow the cross product (|coordinates| > ~1e154); such a
-            // plane is not representable, so the triangle is counted as non-finite.
-            const double k = -dot(n, v0);
-            if (!isFinite(n) || !std::isfinite(k)) {
-                ++s.stats.nonFiniteTriangles;
-                continue;
-            }
-            double *p = &s.planes[4 * id];
-            p[0] = n.x, p[1] = n.y, p[2] = n.z, p[3] = k;
-            s.planeBounds[2 * id] = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
-            s.planeBounds[2 * id + 1] = std::fmax(maxAbs(v0), std::fmax(maxAbs(v1), maxAbs(v2)));
-            items.push_back({v0 + v1 + v2, uint32_t(id)});
-        }
 
         // 2. Chunks. A source object small enough stays one object (named without "#k").
         leaves.clear();
@@ -196,19 +227,7 @@ bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *outSce
             so.vertexEnd = uint32_t(s.positions.size());
             so.triEnd = uint32_t(s.objectTriangles.size());
 
-            // Conservative bounding sphere: center = AABB center, radius = the largest computed
-            // distance to a vertex, rounded up. A computed dot(d, d) has at most 5 rounded operations
-            // along any path (subtraction, square, two additions; all terms are >= 0), so it is within
-            // a relative gamma(5) of the true squared distance; the sqrt halves that and adds half an
-            // ulp, leaving the distance within a relative gamma(4). Scaling by (1 + gamma(6)) (itself
-            // rounded by at most half an ulp, covered by the slack) makes the radius an upper bound.
-            so.sphere.center = so.bounds.center();
-            double r2 = 0;
-            for (uint32_t v = so.vertexBegin; v < so.vertexEnd; ++v) {
-                const Vec3 d = s.positions[v] - so.sphere.center;
-                r2 = std::max(r2, dot(d, d));
-            }
-            so.sphere.radius = std::sqrt(r2) * (1 + gamma(6));
+            boundingSphere(s, so);
             s.bounds.extend(so.bounds);
             s.objects.push_back(std::move(so));
         }
