@@ -441,6 +441,434 @@ bool readLevelParts(const fs::path &p, LevelParts *t, std::string *err) {
 
 }  // namespace
 
+// What the sections share: the options, the table they fill, the benchmark scene and its camera,
+// the z-buffer figures (zbuffer and llvmpipe), llvmpipe's (pipeline compares with them), and the
+// scene written as files (load, analyze).
+struct Bench {
+    explicit Bench(const Options &options) : o(options) {}
+    const Options &o;
+    Table table;
+    unsigned cores = 0;
+    RawMesh mesh;
+    Camera cam;
+    double tris = 0;
+    ZbufferFigures z;
+    double lpOne = NAN, lpCull = NAN;
+    std::string lpNote;
+    fs::path objPath, gltfPath, plyPath;
+};
+
+// The "llvmpipe" section (bench/README: what it measures).
+int sectionLlvmpipe(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    double &lpOne = b.lpOne, &lpCull = b.lpCull;
+    std::string &lpNote = b.lpNote;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+#ifdef VISAUDIT_BENCH_LLVMPIPE
+    progress("llvmpipe");
+    std::vector<float> pos;
+    for (const Vec3 &p : mesh.positions) pos.insert(pos.end(), {float(p.x), float(p.y), float(p.z)});
+    float m[16];
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) m[4 * r + c] = float(cam.clipFromWorld.m[r][c]);
+    const bench::LlvmpipeRun lp = bench::drawWithLlvmpipe(pos, mesh.indices, m, cam.width, cam.height, o.reps);
+    if (lp.ok) {
+        lpOne = best(lp.cpuSeconds);
+        lpCull = best(lp.cullCpuSeconds);
+        lpNote = fmt("llvmpipe: renderer \"%s\", LP_NUM_THREADS=0, D24S8 FBO, color writes off, depth LESS; "
+                     "samples covered %llu (ours: %llu fragments), depth passes %llu (ours: %llu); "
+                     "process CPU time of clear + draw + glFinish (wall best %.1f ms)",
+                     lp.renderer.c_str(), (unsigned long long)lp.samplesCovered, (unsigned long long)z.fragments,
+                     (unsigned long long)lp.samplesPassed, (unsigned long long)z.depthPasses,
+                     1e3 * best(lp.wallSeconds));
+    } else {
+        lpNote = "llvmpipe: not measured: " + lp.error;
+    }
+#else
+    lpNote = "llvmpipe: not measured: bench_table was built without EGL/OpenGL (scripts/install-deps.sh)";
+#endif
+    return 0;
+}
+
+// The "zbuffer" section (bench/README: what it measures).
+int sectionZbuffer(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    table.rule("zbuffer (f32, 1920x1080, 1,000,002 triangles in; rasterize() on clipped triangles)");
+    const bool havePeer = std::isfinite(lpOne);
+    const std::string peer = havePeer ? fmt("llvmpipe 1 thread: %.2f M tri/s", tris / lpOne * 1e-6) : "llvmpipe: n/a";
+    const double mOne = tris / z.oneS * 1e-6;
+    table.add({"zbuffer, 1 thread, no backface", fmt("%.2f M tri/s, %.1f M frag/s", mOne, z.fragments / z.oneS * 1e-6),
+               peer, havePeer ? fmt("%.2fx", lpOne / z.oneS) : "",
+               ">= 30 M tri/s, >= 3x llvmpipe",
+               verdict(mOne >= 30 && (!havePeer || lpOne / z.oneS >= 3))});
+    table.add({fmt("zbuffer, all threads (%u), no backface", cores),
+               fmt("%.2f M tri/s, %.1f M frag/s", tris / z.allS * 1e-6, z.fragments / z.allS * 1e-6),
+               fmt("1 thread: %.2f M tri/s", mOne), fmt("%.2fx", z.oneS / z.allS), "", ""});
+    const std::string cullPeer = std::isfinite(lpCull) ? fmt("llvmpipe 1 thread, GL_CULL_FACE: %.2f M tri/s", tris / lpCull * 1e-6) : "";
+    table.add({"zbuffer, 1 thread, backface stage + rasterize",
+               fmt("%.2f M tri/s, %.1f M frag/s", tris / z.oneCullS * 1e-6, z.fragmentsCulled / z.oneCullS * 1e-6),
+               cullPeer, std::isfinite(lpCull) ? fmt("%.2fx", lpCull / z.oneCullS) : "", "", ""});
+    table.add({fmt("zbuffer, all threads (%u), backface stage + rasterize", cores),
+               fmt("%.2f M tri/s, %.1f M frag/s", tris / z.allCullS * 1e-6, z.fragmentsCulled / z.allCullS * 1e-6),
+               fmt("1 thread: %.2f M tri/s", tris / z.oneCullS * 1e-6), fmt("%.2fx", z.oneCullS / z.allCullS), "", ""});
+    table.add({"clip + zbuffer, 1 thread, no backface (what llvmpipe's draw includes)",
+               fmt("%.2f M tri/s (clip %.1f ms)", tris / (z.clipS + z.oneS) * 1e-6, 1e3 * z.clipS), peer,
+               havePeer ? fmt("%.2fx", lpOne / (z.clipS + z.oneS)) : "", "", ""});
+    table.notes.push_back(fmt("zbuffer: %llu fragments, %llu depth passes; backface stage keeps %llu of %.0f triangles "
+                              "(%llu fragments)", (unsigned long long)z.fragments, (unsigned long long)z.depthPasses,
+                              (unsigned long long)z.kept, tris, (unsigned long long)z.fragmentsCulled));
+    return 0;
+}
+
+// The "raycast" section (bench/README: what it measures).
+int sectionRaycast(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    progress("raycast: BVH build");
+    std::vector<uint32_t> ids(mesh.indices.size() / 3);
+    for (uint32_t t = 0; t < ids.size(); ++t) ids[t] = t;
+    Aabb bounds;
+    for (const Vec3 &p : mesh.positions) bounds.extend(p);
+    RayScene rs;
+    const double b0 = wallNow();
+    if (!rs.build({mesh.positions.data(), mesh.indices.data()}, mesh.positions.size(), ids, bounds.center(), &err)) {
+        std::fprintf(stderr, "bench_table: %s\n", err.c_str());
+        return 3;
+    }
+    const double buildS = wallNow() - b0;
+    progress("raycast");
+    // The raycast stage's own options (analysis/pipeline.cpp): back-face rejection, ties to the lowest id.
+    const Scene scene = sceneOfMesh(mesh);
+    PrimaryOptions stage;
+    stage.rejectBackFaces = true;
+    stage.planes = scene.planes.data();
+    stage.tiesToLowestId = true;
+    std::vector<double> raw, one, all, stageOne;
+    uint64_t rawHits = 0;
+    RaycastStats st;
+    for (int r = 0; r < o.reps; ++r) {  // interleaved, so that all see the same machine load
+        double c0 = threadCpu();
+        rawHits = rs.castPrimaryRaw(cam);
+        raw.push_back(threadCpu() - c0);
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            c0 = threadCpu();
+            const RaycastImage img = rs.castPrimary(cam, &st);
+            one.push_back(threadCpu() - c0);
+            c0 = threadCpu();
+            const RaycastImage img2 = rs.castPrimary(cam, stage, nullptr);
+            stageOne.push_back(threadCpu() - c0);
+        }
+        const double w0 = wallNow();
+        const RaycastImage img = rs.castPrimary(cam, nullptr);
+        all.push_back(wallNow() - w0);
+    }
+    const double rays = double(cam.width) * cam.height;
+    table.rule(fmt("raycast (Embree BVH build %.2f s; %.0f rays, %llu hits)", buildS, rays, (unsigned long long)st.hits));
+    const double ratio = best(raw) / best(one);
+    table.add({"castPrimary, 1 thread (ids + depths written)", fmt("%.2f M rays/s", rays / best(one) * 1e-6),
+               fmt("raw rtcIntersect16, 1 thread: %.2f M rays/s", rays / best(raw) * 1e-6), fmt("%.3fx", ratio),
+               ">= 0.9x raw", verdict(ratio >= 0.9 && rawHits == st.hits)});
+    table.add({fmt("castPrimary, all threads (%u)", cores), fmt("%.2f M rays/s", rays / best(all) * 1e-6),
+               fmt("raw, 1 thread: %.2f M rays/s", rays / best(raw) * 1e-6), fmt("%.2fx", best(raw) / best(all)), "", ""});
+    table.add({"castPrimary as the raycast stage calls it (back-face rejection, ties), 1 thread",
+               fmt("%.2f M rays/s", rays / best(stageOne) * 1e-6),
+               fmt("raw, 1 thread: %.2f M rays/s", rays / best(raw) * 1e-6), fmt("%.3fx", best(raw) / best(stageOne)),
+               "", ""});
+    return 0;
+}
+
+// The "pipeline" section (bench/README: what it measures).
+int sectionPipeline(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    progress("pipeline: frustum, backface, clip, z-buffer on one thread");
+    const Scene scene = sceneOfMesh(mesh);
+    const PipelineFigures f = runPipeline(o, scene, cam);
+    table.rule(fmt("the game's pipeline, 1 thread (1,000,002 triangles, %llu object(s), 1920x1080, f32; M scene "
+                   "triangles/s: the 1,000,002 input triangles over each stage's time)",
+                   (unsigned long long)f.objects));
+    auto mtri = [&](double sec) { return tris / sec * 1e-6; };
+    table.add({"frustum + backface + clip + z-buffer", fmt("%.2f M tri/s (%.1f ms)", mtri(f.totalS), 1e3 * f.totalS),
+               "Masked Occlusion Culling 1 thread, backface on: ~49 M tri/s (anchor, approximate)", "",
+               ">= 40 M tri/s", verdict(mtri(f.totalS) >= 40)});
+    table.add({"frustum", fmt("%.1f M tri/s (%.2f ms; %llu of %llu objects kept)", mtri(f.frustumS), 1e3 * f.frustumS,
+                              (unsigned long long)f.visibleObjects, (unsigned long long)f.objects),
+               "", "", "", ""});
+    table.add({"backface", fmt("%.1f M tri/s (%.1f ms; keeps %llu)", mtri(f.backfaceS), 1e3 * f.backfaceS,
+                               (unsigned long long)f.kept),
+               "", "", ">= 300 M tri/s", verdict(mtri(f.backfaceS) >= 300)});
+    table.add({"clip", fmt("%.1f M tri/s (%.1f ms; %llu screen triangles out)", mtri(f.clipS), 1e3 * f.clipS,
+                           (unsigned long long)f.screenTriangles),
+               "", "", ">= 150 M tri/s", verdict(mtri(f.clipS) >= 150)});
+    table.add({"z-buffer (after backface)", fmt("%.1f M tri/s (%.1f ms)", mtri(f.zbufferS), 1e3 * f.zbufferS),
+               "Mesa llvmpipe 1 thread: 7.4 M tri/s, 13 with GL_CULL_FACE (anchors)", "", ">= 40 M tri/s",
+               verdict(mtri(f.zbufferS) >= 40)});
+    return 0;
+}
+
+// The "level" section (bench/README: what it measures).
+int sectionLevel(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    const fs::path map = o.data / "openarena" / "pak6-patch088.pk3";
+    if (o.data.empty() || !fs::exists(map)) {
+        table.rule("real level: not measured (no data/openarena: run scripts/fetch-data.sh, pass --data DIR)");
+    } else {
+        progress("level: visaudit analyze oa_thor --views spawns, 1920x1080, 2 threads (a minute or two)");
+        const fs::path out = o.work / "level";
+        fs::remove_all(out);
+        const ChildRun c = runChild({o.visaudit, "analyze", map.string() + ":maps/oa_thor.bsp", "--views", "spawns",
+                                     "--width", "1920", "--height", "1080", "--threads", "2", "--out", out.string(),
+                                     "--quiet"},
+                                    o.work / "level.log");
+        LevelParts L;
+        if (c.status != 0 || !readLevelParts(out / "report.json", &L, &err)) {
+            table.rule(fmt("real level: analyze failed (exit %d; see %s)", c.status, (o.work / "level.log").c_str()));
+        } else {
+            // Issue 18's baseline: 118 s wall on 2 cores for this run before the work on it.
+            constexpr double kBaselineS = 118;
+            table.rule(fmt("real level (visaudit analyze pak6-patch088.pk3:maps/oa_thor.bsp --views spawns "
+                           "--width 1920 --height 1080 --threads 2; %llu triangles, %zu views)",
+                           (unsigned long long)L.triangles, L.views));
+            table.add({"analyze, 2 threads: process wall time", fmt("%.1f s, peak %.0f MiB", c.wallS, c.peakMiB),
+                       fmt("issue 18's baseline: %.0f s", kBaselineS), fmt("%.2fx faster", kBaselineS / c.wallS),
+                       ">= 5x faster", verdict(kBaselineS / c.wallS >= 5)});
+            // A part of the views: its share of the views' time; the output phase: of the run's
+            // CPU time (views + output).
+            const double cpu = L.viewsTotal + L.images + L.reportHtml;
+            auto part = [&](const char *name, double ms, const std::string &floor, bool pass, bool ofRun = false) {
+                table.add({name, fmt("%.1f CPU s", ms / 1e3), "",
+                           fmt("%.0f%% of the %s", 100 * ms / (ofRun ? cpu : L.viewsTotal), ofRun ? "run" : "views"),
+                           floor, floor.empty() ? "" : verdict(pass)});
+            };
+            part("ordering audit (painter's, BSP, scanline, overdraw by order)", L.ordering,
+                 "<= 20% of a view's time", L.ordering <= 0.2 * L.viewsTotal);
+            part("images (output.images_ms) + report + HTML", L.images + L.reportHtml, "<= 15% of the run",
+                 L.images + L.reportHtml <= 0.15 * cpu, true);
+            part("z-fighting in every format (depth.ms)", L.zfight, "<= 10% of a view's time",
+                 L.zfight <= 0.1 * L.viewsTotal);
+            part("raycast stage", L.raycast, "", true);
+            part("reference visibility audit + cross-check", L.referenceAndCross, "", true);
+            part("the game's pipeline: cells, frustum, occlusion, backface, clip, z-buffer", L.pipeline, "", true);
+            part("detail audit", L.detail, "", true);
+            part("rest of the views' time (bookkeeping, freeing)",
+                 L.viewsTotal - L.ordering - L.zfight - L.raycast - L.referenceAndCross - L.pipeline - L.detail, "",
+                 true);
+            table.notes.push_back(fmt("level: shares are of the CPU time summed over views (views' total_ms %.1f s) "
+                                      "plus the output phase; once per scene: load %.0f ms, ray scene %.0f ms, "
+                                      "BSP tree %.0f ms", L.viewsTotal / 1e3, L.load, L.raySceneBuild, L.bspBuild));
+        }
+        if (!o.keep) fs::remove_all(out);
+    }
+    return 0;
+}
+
+// The "load" section (bench/README: what it measures).
+int sectionLoad(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    progress("load");
+    table.rule("load (loadScene: the file's reader, then the scene build; 1,000,002 triangles)");
+    for (const fs::path &p : {objPath, gltfPath, plyPath}) {
+        std::vector<double> t;
+        size_t got = 0;
+        for (int r = 0; r < std::max(1, o.reps / 2); ++r) {
+            Scene s;
+            const double w0 = wallNow();
+            if (!loadScene(p.string(), {}, &s, &err)) {
+                std::fprintf(stderr, "bench_table: %s\n", err.c_str());
+                return 3;
+            }
+            t.push_back(wallNow() - w0);
+            got = s.triangleCount();
+        }
+        uintmax_t bytes = fs::file_size(p);
+        if (p.extension() == ".gltf") bytes += fs::file_size(fs::path(p).replace_extension(".bin"));
+        const bool isPly = p.extension() == ".ply";
+        table.add({"load " + p.extension().string().substr(1) + fmt(" (%.0f MB)", bytes / 1e6),
+                   fmt("%.2f s, %.2f M tri/s", best(t), got / best(t) * 1e-6), "", "",
+                   isPly ? "" : "about 1 s (<= 1.5 s)", isPly ? "" : verdict(best(t) <= 1.5 && got == size_t(tris))});
+    }
+    return 0;
+}
+
+// The "analyze" section (bench/README: what it measures).
+int sectionAnalyze(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    progress("analyze: 16 orbit views, 1920x1080, one thread");
+    table.rule("analyze end to end (visaudit analyze bench_scene.obj --views orbit:16 --width 1920 --height 1080)");
+    for (int threads : {1, 0}) {
+        const fs::path out = o.work / fmt("analyze-t%d", threads);
+        fs::remove_all(out);
+        const ChildRun c = runChild({o.visaudit, "analyze", objPath.string(), "--views", "orbit:16", "--width", "1920",
+                                     "--height", "1080", "--threads", std::to_string(threads), "--out",
+                                     out.string(), "--quiet"},
+                                    o.work / fmt("analyze-t%d.log", threads));
+        ReportTimes rt;
+        if (c.status != 0 || !readReportTimes(out / "report.json", &rt, &err)) {
+            table.add({fmt("analyze, %s", threads ? "1 thread" : "all threads"),
+                       fmt("failed (exit %d; see %s)", c.status, (o.work / fmt("analyze-t%d.log", threads)).c_str()),
+                       "", "", "", "FAIL"});
+            continue;
+        }
+        const double sumS = rt.sum() / 1e3;
+        if (threads == 1) {
+            table.add({"analyze, 1 thread: process wall time", fmt("%.2f s, peak %.0f MiB", c.wallS, c.peakMiB),
+                       fmt("sum of report timings: %.2f s", sumS), fmt("%.3fx", c.wallS / sumS), "<= 1.3x",
+                       verdict(c.wallS / sumS <= 1.3)});
+            table.notes.push_back(fmt("analyze timings (report.json, 1 thread): load_ms %.0f, ray_scene_build_ms %.0f, "
+                                      "bsp_tree.build_ms %.0f, stages[].ms %.0f, audits' ms (audit, depth, ordering, "
+                                      "detail, raycast.cross_check, raycast.effects) %.0f; views' total_ms %.0f; "
+                                      "output.images_ms %.0f, output.report_ms %.0f, output.html_ms %.0f; process "
+                                      "wall time not inside load, ray scene, BSP tree, a view's total_ms or the output "
+                                      "phase (start-up and dynamic linking, writing report.json, the folder swap, "
+                                      "freeing at exit): %.0f ms",
+                                      rt.loadMs, rt.raySceneMs, rt.bspMs, rt.stagesMs, rt.auditsMs, rt.viewsTotalMs,
+                                      rt.imagesMs, rt.reportMs, rt.htmlMs,
+                                      1e3 * c.wallS - rt.loadMs - rt.raySceneMs - rt.bspMs - rt.viewsTotalMs -
+                                          rt.outputMs()));
+        } else {
+            table.add({fmt("analyze, all threads (%u): process wall time", cores),
+                       fmt("%.2f s, peak %.0f MiB", c.wallS, c.peakMiB),
+                       fmt("sum of report timings: %.2f s", sumS), fmt("%.3fx", c.wallS / sumS), "", ""});
+        }
+    }
+    return 0;
+}
+
+// The "scaling" section (bench/README: what it measures).
+int sectionScaling(Bench &b) {
+    [[maybe_unused]] const Options &o = b.o;
+    [[maybe_unused]] Table &table = b.table;
+    [[maybe_unused]] const RawMesh &mesh = b.mesh;
+    [[maybe_unused]] const Camera &cam = b.cam;
+    [[maybe_unused]] const double tris = b.tris;
+    [[maybe_unused]] const unsigned cores = b.cores;
+    [[maybe_unused]] const ZbufferFigures &z = b.z;
+    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
+    [[maybe_unused]] std::string err;
+    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+    // Spheres of segments x bands: 100 * 2 * S * (B - 1) + 2 triangles.
+    struct Size {
+        const char *name;
+        int S, B;
+    };
+    std::vector<Size> sizes = {{"10k", 10, 6}, {"100k", 20, 26}, {"1M", 100, 51}, {"10M", 500, 101}};
+    std::vector<int> views = {1, 4, 16, 64};
+    if (o.quick) sizes.pop_back(), views.pop_back();
+    const int sw = 640, sh = 360;
+    // --no-ordering: the draw-order audit runs only below --ordering-max-triangles (200k; its BSP tree
+    // can grow quadratically), so with it on, 10k and 100k would pay for a stage 1M and 10M skip.
+    table.rule(fmt("scaling (visaudit analyze SCENE.ply --views orbit:V --width %d --height %d --no-ordering, "
+                   "every other default stage, all threads; wall s / peak MiB; ratio vs linear from the previous "
+                   "row / column)", sw, sh));
+    std::vector<std::vector<ChildRun>> runs(sizes.size());
+    std::vector<double> triCount(sizes.size());
+    for (size_t i = 0; i < sizes.size(); ++i) {
+        progress(fmt("scaling: writing %s", sizes[i].name));
+        RawMesh m = sphereGridMesh(sizes[i].S, sizes[i].B);
+        triCount[i] = double(m.indices.size() / 3);
+        const fs::path ply = o.work / fmt("grid_%s.ply", sizes[i].name);
+        if (!writePly(ply, m)) {
+            std::fprintf(stderr, "bench_table: cannot write %s\n", ply.c_str());
+            return 3;
+        }
+        m = RawMesh{};
+        for (int v : views) {
+            progress(fmt("scaling: %s triangles, %d views", sizes[i].name, v));
+            const fs::path out = o.work / fmt("scale-%s-%d", sizes[i].name, v);
+            runs[i].push_back(runChild({o.visaudit, "analyze", ply.string(), "--views", "orbit:" + std::to_string(v),
+                                        "--width", std::to_string(sw), "--height", std::to_string(sh),
+                                        "--no-ordering", "--out", out.string(), "--quiet"},
+                                       o.work / fmt("scale-%s-%d.log", sizes[i].name, v)));
+            fs::remove_all(out);
+        }
+        fs::remove(ply);
+    }
+    double worstT = 0, worstV = 0, worstM = 0;
+    for (size_t i = 0; i < sizes.size(); ++i)
+        for (size_t k = 0; k < views.size(); ++k) {
+            const ChildRun &c = runs[i][k];
+            std::string lin;
+            if (i > 0) {
+                const double rt = c.wallS / runs[i - 1][k].wallS / (triCount[i] / triCount[i - 1]);
+                const double rm = c.peakMiB / runs[i - 1][k].peakMiB / (triCount[i] / triCount[i - 1]);
+                worstT = std::max(worstT, rt), worstM = std::max(worstM, rm);
+                lin += fmt("x%.0f tri: time %.2f, mem %.2f", triCount[i] / triCount[i - 1], rt, rm);
+            }
+            if (k > 0) {
+                const double rv = c.wallS / runs[i][k - 1].wallS / (double(views[k]) / views[k - 1]);
+                worstV = std::max(worstV, rv);
+                lin += fmt("%sx%d views: time %.2f", lin.empty() ? "" : "; ", views[k] / views[k - 1], rv);
+            }
+            const bool big = i + 1 == sizes.size() && sizes[i].S == 500;
+            table.add({fmt("%s triangles x %d views", sizes[i].name, views[k]),
+                       c.status ? fmt("failed (exit %d)", c.status) : fmt("%.2f s / %.0f MiB", c.wallS, c.peakMiB),
+                       "", lin, big ? "fits in 8 GiB" : "", big ? verdict(c.status == 0 && c.peakMiB <= 8192) : ""});
+        }
+    table.add({"scaling: worst ratio vs linear", fmt("time x tri %.2f, time x views %.2f, memory x tri %.2f", worstT, worstV, worstM),
+               "", "", "<= 1.25 (linear, 25% noise)", verdict(worstT <= 1.25 && worstV <= 1.25 && worstM <= 1.25)});
+    return 0;
+}
+
 int main(int argc, char **argv) {
     Options o;
     const std::vector<std::string> allSections = {"zbuffer", "llvmpipe", "raycast", "pipeline", "load",
@@ -497,353 +925,58 @@ int main(int argc, char **argv) {
         return 2;
     }
 
-    Table table;
-    const unsigned cores = std::thread::hardware_concurrency();
+    Bench b(o);
+    b.cores = std::thread::hardware_concurrency();
     progress("building the benchmark scene");
-    RawMesh mesh = sphereGridMesh();
-    Camera cam;
+    b.mesh = sphereGridMesh();
     std::string err;
-    if (!makeCamera(benchmarkCamera(), &cam, &err)) {
+    if (!makeCamera(benchmarkCamera(), &b.cam, &err)) {
         std::fprintf(stderr, "bench_table: camera: %s\n", err.c_str());
         return 3;
     }
-    const double tris = double(mesh.indices.size() / 3);
+    b.tris = double(b.mesh.indices.size() / 3);
 
     // zbuffer and its peer.
-    ZbufferFigures z;
     if (o.on("zbuffer") || o.on("llvmpipe")) {
-        const Scene scene = sceneOfMesh(mesh);
+        const Scene scene = sceneOfMesh(b.mesh);
         progress("zbuffer");
-        z = runZbuffer(o, scene, cam);
+        b.z = runZbuffer(o, scene, b.cam);
     }
-    double lpOne = NAN, lpCull = NAN;
-    std::string lpNote;
-    if (o.on("llvmpipe")) {
-#ifdef VISAUDIT_BENCH_LLVMPIPE
-        progress("llvmpipe");
-        std::vector<float> pos;
-        for (const Vec3 &p : mesh.positions) pos.insert(pos.end(), {float(p.x), float(p.y), float(p.z)});
-        float m[16];
-        for (int r = 0; r < 4; ++r)
-            for (int c = 0; c < 4; ++c) m[4 * r + c] = float(cam.clipFromWorld.m[r][c]);
-        const bench::LlvmpipeRun lp = bench::drawWithLlvmpipe(pos, mesh.indices, m, cam.width, cam.height, o.reps);
-        if (lp.ok) {
-            lpOne = best(lp.cpuSeconds);
-            lpCull = best(lp.cullCpuSeconds);
-            lpNote = fmt("llvmpipe: renderer \"%s\", LP_NUM_THREADS=0, D24S8 FBO, color writes off, depth LESS; "
-                         "samples covered %llu (ours: %llu fragments), depth passes %llu (ours: %llu); "
-                         "process CPU time of clear + draw + glFinish (wall best %.1f ms)",
-                         lp.renderer.c_str(), (unsigned long long)lp.samplesCovered, (unsigned long long)z.fragments,
-                         (unsigned long long)lp.samplesPassed, (unsigned long long)z.depthPasses,
-                         1e3 * best(lp.wallSeconds));
-        } else {
-            lpNote = "llvmpipe: not measured: " + lp.error;
-        }
-#else
-        lpNote = "llvmpipe: not measured: bench_table was built without EGL/OpenGL (scripts/install-deps.sh)";
-#endif
-    }
-    if (o.on("zbuffer")) {
-        table.rule("zbuffer (f32, 1920x1080, 1,000,002 triangles in; rasterize() on clipped triangles)");
-        const bool havePeer = std::isfinite(lpOne);
-        const std::string peer = havePeer ? fmt("llvmpipe 1 thread: %.2f M tri/s", tris / lpOne * 1e-6) : "llvmpipe: n/a";
-        const double mOne = tris / z.oneS * 1e-6;
-        table.add({"zbuffer, 1 thread, no backface", fmt("%.2f M tri/s, %.1f M frag/s", mOne, z.fragments / z.oneS * 1e-6),
-                   peer, havePeer ? fmt("%.2fx", lpOne / z.oneS) : "",
-                   ">= 30 M tri/s, >= 3x llvmpipe",
-                   verdict(mOne >= 30 && (!havePeer || lpOne / z.oneS >= 3))});
-        table.add({fmt("zbuffer, all threads (%u), no backface", cores),
-                   fmt("%.2f M tri/s, %.1f M frag/s", tris / z.allS * 1e-6, z.fragments / z.allS * 1e-6),
-                   fmt("1 thread: %.2f M tri/s", mOne), fmt("%.2fx", z.oneS / z.allS), "", ""});
-        const std::string cullPeer = std::isfinite(lpCull) ? fmt("llvmpipe 1 thread, GL_CULL_FACE: %.2f M tri/s", tris / lpCull * 1e-6) : "";
-        table.add({"zbuffer, 1 thread, backface stage + rasterize",
-                   fmt("%.2f M tri/s, %.1f M frag/s", tris / z.oneCullS * 1e-6, z.fragmentsCulled / z.oneCullS * 1e-6),
-                   cullPeer, std::isfinite(lpCull) ? fmt("%.2fx", lpCull / z.oneCullS) : "", "", ""});
-        table.add({fmt("zbuffer, all threads (%u), backface stage + rasterize", cores),
-                   fmt("%.2f M tri/s, %.1f M frag/s", tris / z.allCullS * 1e-6, z.fragmentsCulled / z.allCullS * 1e-6),
-                   fmt("1 thread: %.2f M tri/s", tris / z.oneCullS * 1e-6), fmt("%.2fx", z.oneCullS / z.allCullS), "", ""});
-        table.add({"clip + zbuffer, 1 thread, no backface (what llvmpipe's draw includes)",
-                   fmt("%.2f M tri/s (clip %.1f ms)", tris / (z.clipS + z.oneS) * 1e-6, 1e3 * z.clipS), peer,
-                   havePeer ? fmt("%.2fx", lpOne / (z.clipS + z.oneS)) : "", "", ""});
-        table.notes.push_back(fmt("zbuffer: %llu fragments, %llu depth passes; backface stage keeps %llu of %.0f triangles "
-                                  "(%llu fragments)", (unsigned long long)z.fragments, (unsigned long long)z.depthPasses,
-                                  (unsigned long long)z.kept, tris, (unsigned long long)z.fragmentsCulled));
-    }
-    if (!lpNote.empty()) table.notes.push_back(lpNote);
+    if (o.on("llvmpipe"))
+        if (const int code = sectionLlvmpipe(b)) return code;
+    if (o.on("zbuffer"))
+        if (const int code = sectionZbuffer(b)) return code;
+    if (!b.lpNote.empty()) b.table.notes.push_back(b.lpNote);
 
-    if (o.on("raycast")) {
-        progress("raycast: BVH build");
-        std::vector<uint32_t> ids(mesh.indices.size() / 3);
-        for (uint32_t t = 0; t < ids.size(); ++t) ids[t] = t;
-        Aabb bounds;
-        for (const Vec3 &p : mesh.positions) bounds.extend(p);
-        RayScene rs;
-        const double b0 = wallNow();
-        if (!rs.build({mesh.positions.data(), mesh.indices.data()}, mesh.positions.size(), ids, bounds.center(), &err)) {
-            std::fprintf(stderr, "bench_table: %s\n", err.c_str());
-            return 3;
-        }
-        const double buildS = wallNow() - b0;
-        progress("raycast");
-        // The raycast stage's own options (analysis/pipeline.cpp): back-face rejection, ties to the lowest id.
-        const Scene scene = sceneOfMesh(mesh);
-        PrimaryOptions stage;
-        stage.rejectBackFaces = true;
-        stage.planes = scene.planes.data();
-        stage.tiesToLowestId = true;
-        std::vector<double> raw, one, all, stageOne;
-        uint64_t rawHits = 0;
-        RaycastStats st;
-        for (int r = 0; r < o.reps; ++r) {  // interleaved, so that all see the same machine load
-            double c0 = threadCpu();
-            rawHits = rs.castPrimaryRaw(cam);
-            raw.push_back(threadCpu() - c0);
-            {
-                tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-                c0 = threadCpu();
-                const RaycastImage img = rs.castPrimary(cam, &st);
-                one.push_back(threadCpu() - c0);
-                c0 = threadCpu();
-                const RaycastImage img2 = rs.castPrimary(cam, stage, nullptr);
-                stageOne.push_back(threadCpu() - c0);
-            }
-            const double w0 = wallNow();
-            const RaycastImage img = rs.castPrimary(cam, nullptr);
-            all.push_back(wallNow() - w0);
-        }
-        const double rays = double(cam.width) * cam.height;
-        table.rule(fmt("raycast (Embree BVH build %.2f s; %.0f rays, %llu hits)", buildS, rays, (unsigned long long)st.hits));
-        const double ratio = best(raw) / best(one);
-        table.add({"castPrimary, 1 thread (ids + depths written)", fmt("%.2f M rays/s", rays / best(one) * 1e-6),
-                   fmt("raw rtcIntersect16, 1 thread: %.2f M rays/s", rays / best(raw) * 1e-6), fmt("%.3fx", ratio),
-                   ">= 0.9x raw", verdict(ratio >= 0.9 && rawHits == st.hits)});
-        table.add({fmt("castPrimary, all threads (%u)", cores), fmt("%.2f M rays/s", rays / best(all) * 1e-6),
-                   fmt("raw, 1 thread: %.2f M rays/s", rays / best(raw) * 1e-6), fmt("%.2fx", best(raw) / best(all)), "", ""});
-        table.add({"castPrimary as the raycast stage calls it (back-face rejection, ties), 1 thread",
-                   fmt("%.2f M rays/s", rays / best(stageOne) * 1e-6),
-                   fmt("raw, 1 thread: %.2f M rays/s", rays / best(raw) * 1e-6), fmt("%.3fx", best(raw) / best(stageOne)),
-                   "", ""});
-    }
+    if (o.on("raycast"))
+        if (const int code = sectionRaycast(b)) return code;
 
-    if (o.on("pipeline")) {
-        progress("pipeline: frustum, backface, clip, z-buffer on one thread");
-        const Scene scene = sceneOfMesh(mesh);
-        const PipelineFigures f = runPipeline(o, scene, cam);
-        table.rule(fmt("the game's pipeline, 1 thread (1,000,002 triangles, %llu object(s), 1920x1080, f32; M scene "
-                       "triangles/s: the 1,000,002 input triangles over each stage's time)",
-                       (unsigned long long)f.objects));
-        auto mtri = [&](double sec) { return tris / sec * 1e-6; };
-        table.add({"frustum + backface + clip + z-buffer", fmt("%.2f M tri/s (%.1f ms)", mtri(f.totalS), 1e3 * f.totalS),
-                   "Masked Occlusion Culling 1 thread, backface on: ~49 M tri/s (anchor, approximate)", "",
-                   ">= 40 M tri/s", verdict(mtri(f.totalS) >= 40)});
-        table.add({"frustum", fmt("%.1f M tri/s (%.2f ms; %llu of %llu objects kept)", mtri(f.frustumS), 1e3 * f.frustumS,
-                                  (unsigned long long)f.visibleObjects, (unsigned long long)f.objects),
-                   "", "", "", ""});
-        table.add({"backface", fmt("%.1f M tri/s (%.1f ms; keeps %llu)", mtri(f.backfaceS), 1e3 * f.backfaceS,
-                                   (unsigned long long)f.kept),
-                   "", "", ">= 300 M tri/s", verdict(mtri(f.backfaceS) >= 300)});
-        table.add({"clip", fmt("%.1f M tri/s (%.1f ms; %llu screen triangles out)", mtri(f.clipS), 1e3 * f.clipS,
-                               (unsigned long long)f.screenTriangles),
-                   "", "", ">= 150 M tri/s", verdict(mtri(f.clipS) >= 150)});
-        table.add({"z-buffer (after backface)", fmt("%.1f M tri/s (%.1f ms)", mtri(f.zbufferS), 1e3 * f.zbufferS),
-                   "Mesa llvmpipe 1 thread: 7.4 M tri/s, 13 with GL_CULL_FACE (anchors)", "", ">= 40 M tri/s",
-                   verdict(mtri(f.zbufferS) >= 40)});
-    }
+    if (o.on("pipeline"))
+        if (const int code = sectionPipeline(b)) return code;
 
-    if (o.on("level")) {
-        const fs::path map = o.data / "openarena" / "pak6-patch088.pk3";
-        if (o.data.empty() || !fs::exists(map)) {
-            table.rule("real level: not measured (no data/openarena: run scripts/fetch-data.sh, pass --data DIR)");
-        } else {
-            progress("level: visaudit analyze oa_thor --views spawns, 1920x1080, 2 threads (a minute or two)");
-            const fs::path out = o.work / "level";
-            fs::remove_all(out);
-            const ChildRun c = runChild({o.visaudit, "analyze", map.string() + ":maps/oa_thor.bsp", "--views", "spawns",
-                                         "--width", "1920", "--height", "1080", "--threads", "2", "--out", out.string(),
-                                         "--quiet"},
-                                        o.work / "level.log");
-            LevelParts L;
-            if (c.status != 0 || !readLevelParts(out / "report.json", &L, &err)) {
-                table.rule(fmt("real level: analyze failed (exit %d; see %s)", c.status, (o.work / "level.log").c_str()));
-            } else {
-                // Issue 18's baseline: 118 s wall on 2 cores for this run before the work on it.
-                constexpr double kBaselineS = 118;
-                table.rule(fmt("real level (visaudit analyze pak6-patch088.pk3:maps/oa_thor.bsp --views spawns "
-                               "--width 1920 --height 1080 --threads 2; %llu triangles, %zu views)",
-                               (unsigned long long)L.triangles, L.views));
-                table.add({"analyze, 2 threads: process wall time", fmt("%.1f s, peak %.0f MiB", c.wallS, c.peakMiB),
-                           fmt("issue 18's baseline: %.0f s", kBaselineS), fmt("%.2fx faster", kBaselineS / c.wallS),
-                           ">= 5x faster", verdict(kBaselineS / c.wallS >= 5)});
-                // A part of the views: its share of the views' time; the output phase: of the run's
-                // CPU time (views + output).
-                const double cpu = L.viewsTotal + L.images + L.reportHtml;
-                auto part = [&](const char *name, double ms, const std::string &floor, bool pass, bool ofRun = false) {
-                    table.add({name, fmt("%.1f CPU s", ms / 1e3), "",
-                               fmt("%.0f%% of the %s", 100 * ms / (ofRun ? cpu : L.viewsTotal), ofRun ? "run" : "views"),
-                               floor, floor.empty() ? "" : verdict(pass)});
-                };
-                part("ordering audit (painter's, BSP, scanline, overdraw by order)", L.ordering,
-                     "<= 20% of a view's time", L.ordering <= 0.2 * L.viewsTotal);
-                part("images (output.images_ms) + report + HTML", L.images + L.reportHtml, "<= 15% of the run",
-                     L.images + L.reportHtml <= 0.15 * cpu, true);
-                part("z-fighting in every format (depth.ms)", L.zfight, "<= 10% of a view's time",
-                     L.zfight <= 0.1 * L.viewsTotal);
-                part("raycast stage", L.raycast, "", true);
-                part("reference visibility audit + cross-check", L.referenceAndCross, "", true);
-                part("the game's pipeline: cells, frustum, occlusion, backface, clip, z-buffer", L.pipeline, "", true);
-                part("detail audit", L.detail, "", true);
-                part("rest of the views' time (bookkeeping, freeing)",
-                     L.viewsTotal - L.ordering - L.zfight - L.raycast - L.referenceAndCross - L.pipeline - L.detail, "",
-                     true);
-                table.notes.push_back(fmt("level: shares are of the CPU time summed over views (views' total_ms %.1f s) "
-                                          "plus the output phase; once per scene: load %.0f ms, ray scene %.0f ms, "
-                                          "BSP tree %.0f ms", L.viewsTotal / 1e3, L.load, L.raySceneBuild, L.bspBuild));
-            }
-            if (!o.keep) fs::remove_all(out);
-        }
-    }
+    if (o.on("level"))
+        if (const int code = sectionLevel(b)) return code;
 
-    fs::path objPath = o.work / "bench_scene.obj", gltfPath = o.work / "bench_scene.gltf",
-             plyPath = o.work / "bench_scene.ply";
+    b.objPath = o.work / "bench_scene.obj", b.gltfPath = o.work / "bench_scene.gltf", b.plyPath = o.work / "bench_scene.ply";
     if (o.on("load") || o.on("analyze")) {
         progress("writing the scene as OBJ, glTF and PLY");
-        if (!writeObj(objPath, mesh) || !writeGltf(gltfPath, mesh) || !writePly(plyPath, mesh)) {
+        if (!writeObj(b.objPath, b.mesh) || !writeGltf(b.gltfPath, b.mesh) || !writePly(b.plyPath, b.mesh)) {
             std::fprintf(stderr, "bench_table: cannot write the scene files into %s\n", o.work.c_str());
             return 3;
         }
     }
-    if (o.on("load")) {
-        progress("load");
-        table.rule("load (loadScene: the file's reader, then the scene build; 1,000,002 triangles)");
-        for (const fs::path &p : {objPath, gltfPath, plyPath}) {
-            std::vector<double> t;
-            size_t got = 0;
-            for (int r = 0; r < std::max(1, o.reps / 2); ++r) {
-                Scene s;
-                const double w0 = wallNow();
-                if (!loadScene(p.string(), {}, &s, &err)) {
-                    std::fprintf(stderr, "bench_table: %s\n", err.c_str());
-                    return 3;
-                }
-                t.push_back(wallNow() - w0);
-                got = s.triangleCount();
-            }
-            uintmax_t bytes = fs::file_size(p);
-            if (p.extension() == ".gltf") bytes += fs::file_size(fs::path(p).replace_extension(".bin"));
-            const bool isPly = p.extension() == ".ply";
-            table.add({"load " + p.extension().string().substr(1) + fmt(" (%.0f MB)", bytes / 1e6),
-                       fmt("%.2f s, %.2f M tri/s", best(t), got / best(t) * 1e-6), "", "",
-                       isPly ? "" : "about 1 s (<= 1.5 s)", isPly ? "" : verdict(best(t) <= 1.5 && got == size_t(tris))});
-        }
-    }
+    if (o.on("load"))
+        if (const int code = sectionLoad(b)) return code;
 
-    if (o.on("analyze")) {
-        progress("analyze: 16 orbit views, 1920x1080, one thread");
-        table.rule("analyze end to end (visaudit analyze bench_scene.obj --views orbit:16 --width 1920 --height 1080)");
-        for (int threads : {1, 0}) {
-            const fs::path out = o.work / fmt("analyze-t%d", threads);
-            fs::remove_all(out);
-            const ChildRun c = runChild({o.visaudit, "analyze", objPath.string(), "--views", "orbit:16", "--width", "1920",
-                                         "--height", "1080", "--threads", std::to_string(threads), "--out",
-                                         out.string(), "--quiet"},
-                                        o.work / fmt("analyze-t%d.log", threads));
-            ReportTimes rt;
-            if (c.status != 0 || !readReportTimes(out / "report.json", &rt, &err)) {
-                table.add({fmt("analyze, %s", threads ? "1 thread" : "all threads"),
-                           fmt("failed (exit %d; see %s)", c.status, (o.work / fmt("analyze-t%d.log", threads)).c_str()),
-                           "", "", "", "FAIL"});
-                continue;
-            }
-            const double sumS = rt.sum() / 1e3;
-            if (threads == 1) {
-                table.add({"analyze, 1 thread: process wall time", fmt("%.2f s, peak %.0f MiB", c.wallS, c.peakMiB),
-                           fmt("sum of report timings: %.2f s", sumS), fmt("%.3fx", c.wallS / sumS), "<= 1.3x",
-                           verdict(c.wallS / sumS <= 1.3)});
-                table.notes.push_back(fmt("analyze timings (report.json, 1 thread): load_ms %.0f, ray_scene_build_ms %.0f, "
-                                          "bsp_tree.build_ms %.0f, stages[].ms %.0f, audits' ms (audit, depth, ordering, "
-                                          "detail, raycast.cross_check, raycast.effects) %.0f; views' total_ms %.0f; "
-                                          "output.images_ms %.0f, output.report_ms %.0f, output.html_ms %.0f; process "
-                                          "wall time not inside load, ray scene, BSP tree, a view's total_ms or the output "
-                                          "phase (start-up and dynamic linking, writing report.json, the folder swap, "
-                                          "freeing at exit): %.0f ms",
-                                          rt.loadMs, rt.raySceneMs, rt.bspMs, rt.stagesMs, rt.auditsMs, rt.viewsTotalMs,
-                                          rt.imagesMs, rt.reportMs, rt.htmlMs,
-                                          1e3 * c.wallS - rt.loadMs - rt.raySceneMs - rt.bspMs - rt.viewsTotalMs -
-                                              rt.outputMs()));
-            } else {
-                table.add({fmt("analyze, all threads (%u): process wall time", cores),
-                           fmt("%.2f s, peak %.0f MiB", c.wallS, c.peakMiB),
-                           fmt("sum of report timings: %.2f s", sumS), fmt("%.3fx", c.wallS / sumS), "", ""});
-            }
-        }
-    }
+    if (o.on("analyze"))
+        if (const int code = sectionAnalyze(b)) return code;
 
-    if (o.on("scaling")) {
-        // Spheres of segments x bands: 100 * 2 * S * (B - 1) + 2 triangles.
-        struct Size {
-            const char *name;
-            int S, B;
-        };
-        std::vector<Size> sizes = {{"10k", 10, 6}, {"100k", 20, 26}, {"1M", 100, 51}, {"10M", 500, 101}};
-        std::vector<int> views = {1, 4, 16, 64};
-        if (o.quick) sizes.pop_back(), views.pop_back();
-        const int sw = 640, sh = 360;
-        // --no-ordering: the draw-order audit runs only below --ordering-max-triangles (200k; its BSP tree
-        // can grow quadratically), so with it on, 10k and 100k would pay for a stage 1M and 10M skip.
-        table.rule(fmt("scaling (visaudit analyze SCENE.ply --views orbit:V --width %d --height %d --no-ordering, "
-                       "every other default stage, all threads; wall s / peak MiB; ratio vs linear from the previous "
-                       "row / column)", sw, sh));
-        std::vector<std::vector<ChildRun>> runs(sizes.size());
-        std::vector<double> triCount(sizes.size());
-        for (size_t i = 0; i < sizes.size(); ++i) {
-            progress(fmt("scaling: writing %s", sizes[i].name));
-            RawMesh m = sphereGridMesh(sizes[i].S, sizes[i].B);
-            triCount[i] = double(m.indices.size() / 3);
-            const fs::path ply = o.work / fmt("grid_%s.ply", sizes[i].name);
-            if (!writePly(ply, m)) {
-                std::fprintf(stderr, "bench_table: cannot write %s\n", ply.c_str());
-                return 3;
-            }
-            m = RawMesh{};
-            for (int v : views) {
-                progress(fmt("scaling: %s triangles, %d views", sizes[i].name, v));
-                const fs::path out = o.work / fmt("scale-%s-%d", sizes[i].name, v);
-                runs[i].push_back(runChild({o.visaudit, "analyze", ply.string(), "--views", "orbit:" + std::to_string(v),
-                                            "--width", std::to_string(sw), "--height", std::to_string(sh),
-                                            "--no-ordering", "--out", out.string(), "--quiet"},
-                                           o.work / fmt("scale-%s-%d.log", sizes[i].name, v)));
-                fs::remove_all(out);
-            }
-            fs::remove(ply);
-        }
-        double worstT = 0, worstV = 0, worstM = 0;
-        for (size_t i = 0; i < sizes.size(); ++i)
-            for (size_t k = 0; k < views.size(); ++k) {
-                const ChildRun &c = runs[i][k];
-                std::string lin;
-                if (i > 0) {
-                    const double rt = c.wallS / runs[i - 1][k].wallS / (triCount[i] / triCount[i - 1]);
-                    const double rm = c.peakMiB / runs[i - 1][k].peakMiB / (triCount[i] / triCount[i - 1]);
-                    worstT = std::max(worstT, rt), worstM = std::max(worstM, rm);
-                    lin += fmt("x%.0f tri: time %.2f, mem %.2f", triCount[i] / triCount[i - 1], rt, rm);
-                }
-                if (k > 0) {
-                    const double rv = c.wallS / runs[i][k - 1].wallS / (double(views[k]) / views[k - 1]);
-                    worstV = std::max(worstV, rv);
-                    lin += fmt("%sx%d views: time %.2f", lin.empty() ? "" : "; ", views[k] / views[k - 1], rv);
-                }
-                const bool big = i + 1 == sizes.size() && sizes[i].S == 500;
-                table.add({fmt("%s triangles x %d views", sizes[i].name, views[k]),
-                           c.status ? fmt("failed (exit %d)", c.status) : fmt("%.2f s / %.0f MiB", c.wallS, c.peakMiB),
-                           "", lin, big ? "fits in 8 GiB" : "", big ? verdict(c.status == 0 && c.peakMiB <= 8192) : ""});
-            }
-        table.add({"scaling: worst ratio vs linear", fmt("time x tri %.2f, time x views %.2f, memory x tri %.2f", worstT, worstV, worstM),
-                   "", "", "<= 1.25 (linear, 25% noise)", verdict(worstT <= 1.25 && worstV <= 1.25 && worstM <= 1.25)});
-    }
+    if (o.on("scaling"))
+        if (const int code = sectionScaling(b)) return code;
 
     std::printf("visaudit benchmark (bench/run.sh): %u cores, best of %d; one-thread figures are thread CPU time "
-                "(llvmpipe: process CPU time), all-thread figures wall time\n", cores, o.reps);
-    table.print();
+                "(llvmpipe: process CPU time), all-thread figures wall time\n", b.cores, o.reps);
+    b.table.print();
     if (madeWork && !o.keep) fs::remove_all(o.work);
     return 0;
 }
