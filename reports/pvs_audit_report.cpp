@@ -354,28 +354,10 @@ bool pvsAuditImage(const PvsAuditResult &r, std::vector<uint8_t> *out, int *widt
     return true;
 }
 
-std::string pvsAuditHtml(const Json &a, const std::string &dir) {
+namespace {
+// The totals, each with its meaning; the far plane, the sampling, the occluders and the time.
+std::string pvsTotalsSection(const Json &a) {
     std::string o;
-    const std::string map = text(a, {"map"});
-    const double misses = num(a, {"totals", "misses"}), slack = num(a, {"totals", "slack_share"});
-    // The same head as report.html: nothing may load from elsewhere.
-    o += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-         "<meta name=\"color-scheme\" content=\"light dark\">"
-         "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src 'self' file: data:; "
-         "style-src 'unsafe-inline'\">"
-         "<title>visaudit PVS audit: " + htmlEscape(map) + "</title><style>" + std::string(html_assets::kCss) +
-         "</style></head><body>\n";
-    o += "<header><h1>PVS audit: " + htmlEscape(map) + "</h1><p class=\"meta\">visaudit " +
-         htmlEscape(text(a, {"tool", "version"})) + " · " + htmlEscape(text(a, {"format"})) + "</p>";
-    o += std::string("<p class=\"verdict ") + (misses > 0 ? "bad" : "good") + "\"><b>" + count(uint64_t(misses)) +
-         " misses</b> (cluster pairs a player's eye sees although the PVS says hidden; best 0) · <b>" + percent(slack) +
-         " slack</b> (PVS-visible pairs no eye point saw)" +
-         (num(a, {"totals", "crack_misses"}) > 0
-              ? " · " + count(uint64_t(num(a, {"totals", "crack_misses"}))) + " crack misses (seen only where no player fits)"
-              : std::string()) +
-         "</p></header>\n";
-    // Totals, each with its meaning.
     struct Row {
         const char *key, *meaning;
     };
@@ -420,7 +402,12 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
          fmt("%.0f", num(a, {"timings_ms", "thread_samples"})) + " ms eye points, " +
          fmt("%.0f", num(a, {"timings_ms", "thread_rays"})) + " ms Embree, " + fmt("%.0f", num(a, {"timings_ms", "thread_walk"})) +
          " ms BSP walk), " + fmt("%.0f", num(a, {"timings_ms", "top_view"})) + " ms for the map image.</p></section>\n";
-    // The image.
+    return o;
+}
+
+// The top-down image, when the folder holds it.
+std::string pvsImageSection(const Json &a, const std::string &dir) {
+    std::string o;
     const Json *img = at(a, {"image"});
     if (img && img->is_string() && std::filesystem::exists(std::filesystem::path(dir) / img->get<std::string>())) {
         const std::string name = htmlEscape(img->get<std::string>());
@@ -430,7 +417,12 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
              "blue its slack share (0% to 100%), gray a cluster not audited. White lines: the first rays that saw a missed "
              "cluster, from the eye (yellow cross) to where they entered it.</figcaption></figure></section>\n";
     }
-    // Histograms as bars.
+    return o;
+}
+
+// The slack and miss histograms of the audited clusters, as bars.
+std::string pvsHistogramSection(const Json &a) {
+    std::string o;
     auto histogram = [&](const char *key, const char *title) {
         const Json *h = at(a, {"histograms", key});
         if (!h || !h->is_array()) return;
@@ -449,7 +441,12 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
     histogram("slack_share", "Slack share per cluster");
     histogram("misses", "Misses per cluster");
     o += "</section>\n";
-    // Worst clusters.
+    return o;
+}
+
+// The clusters with the most misses and the most slack.
+std::string pvsWorstSection(const Json &a) {
+    std::string o;
     auto worstTable = [&](const char *key, const char *title) {
         const Json *w = at(a, {"worst", key});
         o += std::string("<h3>") + title + "</h3>";
@@ -470,7 +467,12 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
     worstTable("misses", "Most misses");
     worstTable("slack", "Most slack");
     o += "</section>\n";
-    // Evidence.
+    return o;
+}
+
+// Every miss (the first 100) with the evidence that proves it.
+std::string pvsMissesSection(const Json &a) {
+    std::string o;
     o += "<section class=\"block\" id=\"misses\"><h2>Misses and their evidence</h2>";
     const Json *ms = at(a, {"misses"});
     if (!ms || !ms->is_array() || ms->empty()) {
@@ -504,6 +506,37 @@ std::string pvsAuditHtml(const Json &a, const std::string &dir) {
         }
         o += "</table></div>";
     }
+    return o;
+}
+
+}  // namespace
+
+std::string pvsAuditHtml(const Json &a, const std::string &dir) {
+    std::string o;
+    const std::string map = text(a, {"map"});
+    const double misses = num(a, {"totals", "misses"}), slack = num(a, {"totals", "slack_share"});
+    // The same head as report.html: nothing may load from elsewhere.
+    o += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+         "<meta name=\"color-scheme\" content=\"light dark\">"
+         "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; img-src 'self' file: data:; "
+         "style-src 'unsafe-inline'\">"
+         "<title>visaudit PVS audit: " + htmlEscape(map) + "</title><style>" + std::string(html_assets::kCss) +
+         "</style></head><body>\n";
+    o += "<header><h1>PVS audit: " + htmlEscape(map) + "</h1><p class=\"meta\">visaudit " +
+         htmlEscape(text(a, {"tool", "version"})) + " · " + htmlEscape(text(a, {"format"})) + "</p>";
+    o += std::string("<p class=\"verdict ") + (misses > 0 ? "bad" : "good") + "\"><b>" + count(uint64_t(misses)) +
+         " misses</b> (cluster pairs a player's eye sees although the PVS says hidden; best 0) · <b>" + percent(slack) +
+         " slack</b> (PVS-visible pairs no eye point saw)" +
+         (num(a, {"totals", "crack_misses"}) > 0
+              ? " · " + count(uint64_t(num(a, {"totals", "crack_misses"}))) + " crack misses (seen only where no player fits)"
+              : std::string()) +
+         "</p></header>\n";
+    o += pvsTotalsSection(a);
+    o += pvsImageSection(a, dir);
+    o += pvsHistogramSection(a);
+    o += pvsWorstSection(a);
+    o += pvsMissesSection(a);
     o += "</section>\n<p class=\"muted\">How to read every number: docs/pvs-audit.md in visaudit's sources.</p></body></html>\n";
     return o;
 }
