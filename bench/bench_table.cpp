@@ -456,21 +456,20 @@ struct Bench {
     double lpOne = NAN, lpCull = NAN;
     std::string lpNote;
     fs::path objPath, gltfPath, plyPath;
+    std::string err;
+    // The sections; each returns 0 or the exit code of a failure it has reported.
+    int sectionLlvmpipe();
+    int sectionZbuffer();
+    int sectionRaycast();
+    int sectionPipeline();
+    int sectionLevel();
+    int sectionLoad();
+    int sectionAnalyze();
+    int sectionScaling();
 };
 
-// The "llvmpipe" section (bench/README: what it measures).
-int sectionLlvmpipe(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    double &lpOne = b.lpOne, &lpCull = b.lpCull;
-    std::string &lpNote = b.lpNote;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
+// The "llvmpipe" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionLlvmpipe() {
 #ifdef VISAUDIT_BENCH_LLVMPIPE
     progress("llvmpipe");
     std::vector<float> pos;
@@ -497,18 +496,8 @@ int sectionLlvmpipe(Bench &b) {
     return 0;
 }
 
-// The "zbuffer" section (bench/README: what it measures).
-int sectionZbuffer(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "zbuffer" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionZbuffer() {
     table.rule("zbuffer (f32, 1920x1080, 1,000,002 triangles in; rasterize() on clipped triangles)");
     const bool havePeer = std::isfinite(lpOne);
     const std::string peer = havePeer ? fmt("llvmpipe 1 thread: %.2f M tri/s", tris / lpOne * 1e-6) : "llvmpipe: n/a";
@@ -536,18 +525,8 @@ int sectionZbuffer(Bench &b) {
     return 0;
 }
 
-// The "raycast" section (bench/README: what it measures).
-int sectionRaycast(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "raycast" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionRaycast() {
     progress("raycast: BVH build");
     std::vector<uint32_t> ids(mesh.indices.size() / 3);
     for (uint32_t t = 0; t < ids.size(); ++t) ids[t] = t;
@@ -602,18 +581,8 @@ int sectionRaycast(Bench &b) {
     return 0;
 }
 
-// The "pipeline" section (bench/README: what it measures).
-int sectionPipeline(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "pipeline" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionPipeline() {
     progress("pipeline: frustum, backface, clip, z-buffer on one thread");
     const Scene scene = sceneOfMesh(mesh);
     const PipelineFigures f = runPipeline(o, scene, cam);
@@ -639,18 +608,8 @@ int sectionPipeline(Bench &b) {
     return 0;
 }
 
-// The "level" section (bench/README: what it measures).
-int sectionLevel(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "level" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionLevel() {
     const fs::path map = o.data / "openarena" / "pak6-patch088.pk3";
     if (o.data.empty() || !fs::exists(map)) {
         table.rule("real level: not measured (no data/openarena: run scripts/fetch-data.sh, pass --data DIR)");
@@ -704,18 +663,8 @@ int sectionLevel(Bench &b) {
     return 0;
 }
 
-// The "load" section (bench/README: what it measures).
-int sectionLoad(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "load" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionLoad() {
     progress("load");
     table.rule("load (loadScene: the file's reader, then the scene build; 1,000,002 triangles)");
     for (const fs::path &p : {objPath, gltfPath, plyPath}) {
@@ -741,18 +690,8 @@ int sectionLoad(Bench &b) {
     return 0;
 }
 
-// The "analyze" section (bench/README: what it measures).
-int sectionAnalyze(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "analyze" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionAnalyze() {
     progress("analyze: 16 orbit views, 1920x1080, one thread");
     table.rule("analyze end to end (visaudit analyze bench_scene.obj --views orbit:16 --width 1920 --height 1080)");
     for (int threads : {1, 0}) {
@@ -794,18 +733,8 @@ int sectionAnalyze(Bench &b) {
     return 0;
 }
 
-// The "scaling" section (bench/README: what it measures).
-int sectionScaling(Bench &b) {
-    [[maybe_unused]] const Options &o = b.o;
-    [[maybe_unused]] Table &table = b.table;
-    [[maybe_unused]] const RawMesh &mesh = b.mesh;
-    [[maybe_unused]] const Camera &cam = b.cam;
-    [[maybe_unused]] const double tris = b.tris;
-    [[maybe_unused]] const unsigned cores = b.cores;
-    [[maybe_unused]] const ZbufferFigures &z = b.z;
-    [[maybe_unused]] const fs::path &objPath = b.objPath, &gltfPath = b.gltfPath, &plyPath = b.plyPath;
-    [[maybe_unused]] std::string err;
-    [[maybe_unused]] const double lpOne = b.lpOne, lpCull = b.lpCull;
+// The "scaling" section of the table (README, "Benchmarks": what it measures).
+int Bench::sectionScaling() {
     // Spheres of segments x bands: 100 * 2 * S * (B - 1) + 2 triangles.
     struct Size {
         const char *name;
@@ -943,19 +872,19 @@ int main(int argc, char **argv) {
         b.z = runZbuffer(o, scene, b.cam);
     }
     if (o.on("llvmpipe"))
-        if (const int code = sectionLlvmpipe(b)) return code;
+        if (const int code = b.sectionLlvmpipe()) return code;
     if (o.on("zbuffer"))
-        if (const int code = sectionZbuffer(b)) return code;
+        if (const int code = b.sectionZbuffer()) return code;
     if (!b.lpNote.empty()) b.table.notes.push_back(b.lpNote);
 
     if (o.on("raycast"))
-        if (const int code = sectionRaycast(b)) return code;
+        if (const int code = b.sectionRaycast()) return code;
 
     if (o.on("pipeline"))
-        if (const int code = sectionPipeline(b)) return code;
+        if (const int code = b.sectionPipeline()) return code;
 
     if (o.on("level"))
-        if (const int code = sectionLevel(b)) return code;
+        if (const int code = b.sectionLevel()) return code;
 
     b.objPath = o.work / "bench_scene.obj", b.gltfPath = o.work / "bench_scene.gltf", b.plyPath = o.work / "bench_scene.ply";
     if (o.on("load") || o.on("analyze")) {
@@ -966,13 +895,13 @@ int main(int argc, char **argv) {
         }
     }
     if (o.on("load"))
-        if (const int code = sectionLoad(b)) return code;
+        if (const int code = b.sectionLoad()) return code;
 
     if (o.on("analyze"))
-        if (const int code = sectionAnalyze(b)) return code;
+        if (const int code = b.sectionAnalyze()) return code;
 
     if (o.on("scaling"))
-        if (const int code = sectionScaling(b)) return code;
+        if (const int code = b.sectionScaling()) return code;
 
     std::printf("visaudit benchmark (bench/run.sh): %u cores, best of %d; one-thread figures are thread CPU time "
                 "(llvmpipe: process CPU time), all-thread figures wall time\n", b.cores, o.reps);
