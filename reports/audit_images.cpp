@@ -48,9 +48,7 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
                         std::to_string(W) + "x" + std::to_string(H) + " buffers";
         return false;
     }
-    double lo, hi;
-    depthRange(ref.depth, &lo, &hi);
-    const DepthGrayScale gray(lo, hi);
+    const DepthGrayScale gray = depthGrayScale(ref.depth);
     std::vector<uint8_t> img(n * 3);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -96,9 +94,7 @@ bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std
                         std::to_string(W) + "x" + std::to_string(H) + " buffers";
         return false;
     }
-    double lo, hi;
-    depthRange(zb.depth, &lo, &hi);
-    const DepthGrayScale gray(lo, hi);
+    const DepthGrayScale gray = depthGrayScale(zb.depth);
     std::vector<uint8_t> img(n * 3);
     for (size_t i = 0; i < n; ++i) {
         const Disagreement d = Disagreement(check.cls[i]);

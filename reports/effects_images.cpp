@@ -28,9 +28,7 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
                       std::string *err) {
     if (!sizesMatch(fx, zb, path, err)) return false;
     const int W = zb.width, H = zb.height;
-    double lo, hi;
-    depthRange(zb.depth, &lo, &hi);
-    const DepthGrayScale gray(lo, hi);
+    const DepthGrayScale gray = depthGrayScale(zb.depth);
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     // A visible pixel is lit, shadowed or facing away; the ray caster's visibility decides which
     // pixels are visible, so lit = visible and neither of the other two.
@@ -60,9 +58,7 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
 bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::string &path, std::string *err) {
     if (!sizesMatch(fx, zb, path, err)) return false;
     const int W = zb.width, H = zb.height;
-    double lo, hi;
-    depthRange(zb.depth, &lo, &hi);
-    const DepthGrayScale gray(lo, hi);
+    const DepthGrayScale gray = depthGrayScale(zb.depth);
     // Depth 1..8+ on the overdraw ramp; 0 (no secondary ray) shows the depth image dimmed.
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     int deepest = 0;

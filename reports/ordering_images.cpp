@@ -35,11 +35,8 @@ OrderingImageNames orderingImageNames(const std::string &baseName) {
 std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH) {
     const int W = ref.width, H = ref.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
-    // Depth range of the reference (the dimmed gray background, log scale as depth.png).
-    double lo = INFINITY, hi = -INFINITY;
-    for (double d : ref.depth)
-        if (std::isfinite(d) && d > 0) lo = std::min(lo, d), hi = std::max(hi, d);
-    const DepthGrayScale gray(lo, hi);
+    // The reference's depths as the dimmed gray background (log scale, as depth.png).
+    const DepthGrayScale gray = depthGrayScale(ref.depth);
     const int scale = W >= 1024 ? 2 : 1;
     const int strip = 13 * scale;
     *canvasH = H + strip;

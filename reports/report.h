@@ -142,6 +142,13 @@ struct DepthGrayScale {
 // The nearest and farthest finite positive depth of a view (depthGray's range): +inf / -inf when
 // nothing is drawn.
 void depthRange(const std::vector<double> &depth, double *dMin, double *dMax);
+// The gray scale of a view's depths over their own range (depthRange): what each image draws its
+// gray background with.
+inline DepthGrayScale depthGrayScale(const std::vector<double> &depth) {
+    double lo, hi;
+    depthRange(depth, &lo, &hi);
+    return DepthGrayScale(lo, hi);
+}
 
 // ---- Files and folders -----------------------------------------------------------------------
 // Reads and parses a JSON file (a report, a baseline, a submission). `unreadable`: the file cannot

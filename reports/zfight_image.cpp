@@ -101,9 +101,7 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     c.fill(0, 0, CW, CH, kZFightStripBackground);
 
     // 1. Dimmed gray view; 2. markers.
-    double dMin, dMax;
-    depthRange(zb.depth, &dMin, &dMax);
-    const DepthGrayScale gray(dMin, dMax);
+    const DepthGrayScale gray = depthGrayScale(zb.depth);
     for (int y = 0; y < H; ++y)
         for (int xx = 0; xx < W; ++xx) {
             const size_t p = size_t(y) * size_t(W) + size_t(xx);
