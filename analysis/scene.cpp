@@ -249,4 +249,19 @@ Scene buildScene(SceneBuildInput &&in, const ChunkSettings &chunks) {
     return s;
 }
 
+Cell boxCell(const std::string &name, Vec3 lo, Vec3 hi) {
+    Cell c;
+    c.name = name;
+    c.box.lo = lo;
+    c.box.hi = hi;
+    for (int a = 0; a < 3; ++a) {
+        Vec3 n{0, 0, 0};
+        n[a] = 1;
+        c.faces.push_back({n, -lo[a]});
+        n[a] = -1;
+        c.faces.push_back({n, hi[a]});
+    }
+    return c;
+}
+
 }  // namespace va

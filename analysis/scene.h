@@ -247,6 +247,8 @@ struct Cell {
     std::vector<HalfSpace> faces;
     Aabb box;                          // the box of a "min"/"max" cell; empty for a "planes" cell
 };
+// A box cell: its six half-spaces n.p + k >= 0 (x - lo.x >= 0, hi.x - x >= 0, ...); lo < hi.
+Cell boxCell(const std::string &name, Vec3 lo, Vec3 hi);
 
 // A convex polygon (3+ coplanar points, in order) joining two cells; seen from either side.
 struct Portal {

@@ -180,20 +180,6 @@ TEST(PortalRooms, CandidatesAreTheInput) {
 
 // ---- Hand-made cells ----------------------------------------------------------------------------
 
-Cell boxCell(const std::string &name, Vec3 lo, Vec3 hi) {
-    Cell c;
-    c.name = name;
-    c.box.lo = lo;
-    c.box.hi = hi;
-    for (int a = 0; a < 3; ++a) {
-        Vec3 n{0, 0, 0};
-        n[a] = 1;
-        c.faces.push_back({n, -lo[a]});
-        n[a] = -1;
-        c.faces.push_back({n, hi[a]});
-    }
-    return c;
-}
 
 // A portal in the plane x = X, over y in [y0, y1] and z in [z0, z1].
 Portal xPortal(uint32_t a, uint32_t b, double x, double y0, double y1, double z0, double z1) {

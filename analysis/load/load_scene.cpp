@@ -228,16 +228,7 @@ bool readCellsAndPortals(Reader &r, const Json &root, std::vector<Cell> *cellsOu
                     if (!(lo[a] < hi[a]))
                         return r.fail(p / "max" / size_t(a), "must be greater than min[" + std::to_string(a) + "] (" +
                                                                   json::Json(lo[a]).dump() + "): a cell has a volume");
-                c.box.lo = lo;
-                c.box.hi = hi;
-                // Six half-spaces n.p + k >= 0: x - lo.x >= 0, hi.x - x >= 0, ...
-                for (int a = 0; a < 3; ++a) {
-                    Vec3 n{0, 0, 0};
-                    n[a] = 1;
-                    c.faces.push_back({n, -lo[a]});
-                    n[a] = -1;
-                    c.faces.push_back({n, hi[a]});
-                }
+                c = boxCell(c.name, lo, hi);
             } else if (j.contains("planes")) {
                 const Path pp = p / "planes";
                 const Json &pl = j["planes"];
