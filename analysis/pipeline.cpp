@@ -58,18 +58,16 @@ std::vector<uint32_t> removed(const std::vector<uint32_t> &before, const std::ve
 
 }  // namespace
 
-// The object stages in the pipeline's fixed coarse-to-fine order (docs/architecture.md). Each row
-// is defined in its stage's file (analysis/stage.h).
-extern const ObjectStage kCellsStage;      // analysis/stages/cells.cpp: portals or a map's PVS
-extern const ObjectStage kGridStage;       // analysis/stages/grid.cpp
-extern const ObjectStage kFrustumStage;    // analysis/stages/frustum.cpp
-extern const ObjectStage kOcclusionStage;  // analysis/stages/occlusion.cpp
+// The object stages in the pipeline's fixed coarse-to-fine order: the rows that
+// analysis/stages/object_stages.def lists, each defined in its stage's file (analysis/stage.h).
+#define VA_OBJECT_STAGE(row) extern const ObjectStage row;
+#include "analysis/stages/object_stages.def"
+#undef VA_OBJECT_STAGE
 namespace {
 constexpr const ObjectStage *kObjectStages[] = {
-    &kCellsStage,
-    &kGridStage,
-    &kFrustumStage,
-    &kOcclusionStage,
+#define VA_OBJECT_STAGE(row) &row,
+#include "analysis/stages/object_stages.def"
+#undef VA_OBJECT_STAGE
 };
 
 void runObjectStage(ViewContext &c, const ObjectStage &stage, std::vector<uint32_t> &objects) {
