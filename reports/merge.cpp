@@ -1,5 +1,7 @@
 #include "reports/merge.h"
 
+#include "reports/findings.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -143,7 +145,7 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
 
     Json m;
     for (const auto &[key, value] : first.items()) {
-        if (key == "views" || key == "totals") continue;
+        if (key == "views" || key == "totals" || key == "findings") continue;
         m[key] = value;
     }
     m["shard"] = {{"index", 1}, {"count", 1}, {"views_total", total}};
@@ -163,6 +165,7 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
     for (const Json *v : views) list.push_back(*v);
     m["views"] = list;
     m["totals"] = reportTotals(m["views"]);
+    addFindings(&m);
     *merged = std::move(m);
     return true;
 }

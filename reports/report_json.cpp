@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "reports/findings.h"
 #include "reports/ordering_images.h"
 #include "reports/report.h"
 #include "reports/report_model.h"
@@ -488,6 +489,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
     for (size_t i = 0; i < r.views.size(); ++i) views.push_back(viewJson(r.views[i], bases[i], r.lightNames, images));
     j["views"] = views;
     j["totals"] = reportTotals(j["views"]);
+    addFindings(&j);
     return j;
 }
 

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "reports/findings.h"
 #include "reports/html.h"
 
 namespace fs = std::filesystem;
@@ -218,7 +219,8 @@ TEST(Html, SixQuestionsAnswerFromTheSectionsPresent) {
     EXPECT_NE(html.find("10 triangles of 100 reaching the z-buffer (10.0%) cover no pixel center"), std::string::npos);
     EXPECT_NE(html.find("What stands between a surface and a light?</span> <span class=\"muted\">not analysed"),
               std::string::npos);
-    EXPECT_NE(html.find("painter's and BSP ordering not analysed"), std::string::npos);
+    // The page escapes every answer whole (the findings are plain text in report.json).
+    EXPECT_NE(html.find("painter&#39;s and BSP ordering not analysed"), std::string::npos);
 
     v["stages"].push_back({{"name", "occlusion"}, {"ran", true}, {"triangles_in", 90}, {"triangles_culled", 40},
                            {"triangles_out", 50}, {"ms", 1}});
@@ -347,4 +349,52 @@ TEST(Html, WriteFailureNamesThePath) {
     std::string err;
     EXPECT_FALSE(va::writeReportHtml(makeReport({}), "/nonexistent-visaudit-dir", &err));
     EXPECT_NE(err.find("/nonexistent-visaudit-dir/report.html"), std::string::npos) << err;
+}
+
+// ---- Findings (reports/findings.h): computed once, stored in the report, presented by the page ----
+
+// Worst first by false-cull pixels, then genuine disagreements, then z-fighting, then overdraw (ties
+// keep the view order); the verdict sums each over views and counts the views that have it.
+TEST(Findings, WorstFirstAndVerdictAreExact) {
+    Json r = makeReport({makeView("calm", 0, 0, 0, 1.1), makeView("culls", 7, 0, 0, 1.0), makeView("fights", 0, 0, 5, 1.9),
+                         makeView("rays", 0, 3, 0, 1.0), makeView("also-culls", 7, 1, 0, 1.0)});
+    va::addFindings(&r);
+    EXPECT_EQ(r["findings"]["worst_first"].dump(), "[4,1,3,2,0]");
+    EXPECT_EQ(r["findings"]["verdict"].dump(),
+              "{\"false_cull_pixels\":14,\"false_cull_views\":2,\"genuine_disagreements\":4,\"genuine_views\":2,"
+              "\"zfight_pixels\":5,\"zfight_views\":1,\"zfight_coplanar_pixels\":0,"
+              "\"worst_overdraw\":{\"view\":2,\"overdraw\":1.9}}");
+    EXPECT_EQ(r["views"][2]["findings"]["score"].dump(),
+              "{\"false_cull_pixels\":0.0,\"genuine_disagreements\":0.0,\"zfight_pixels\":5.0,\"zfight_hotspots\":1,"
+              "\"overdraw\":1.9,\"depth_complexity\":1.5,\"wasted_share\":0.25,\"triangles_drawn\":90}");
+    // The page shows the stored order and verdict: views in the summary worst first.
+    const std::string html = va::reportHtml(r, "");
+    EXPECT_LT(summaryPos(html, 4), summaryPos(html, 1));
+    EXPECT_LT(summaryPos(html, 1), summaryPos(html, 3));
+    EXPECT_NE(html.find("<b>14 falsely culled pixels</b> in 2 views"), std::string::npos);
+    EXPECT_NE(html.find("overdraw up to 1.9 (fights)"), std::string::npos);
+}
+
+// The answers are plain text in the report; a part that was not analysed says why, and the page
+// presents the stored answers rather than computing its own.
+TEST(Findings, AnswersArePlainTextThePagePresents) {
+    Json v = makeView("q", 0, 0, 0, 1.0);
+    v["detail"] = {{"ran", false}, {"reason", "turned off by --no-detail"}};
+    Json r = makeReport({v});
+    va::addFindings(&r);
+    const Json &answers = r["views"][0]["findings"]["answers"];
+    ASSERT_EQ(answers.size(), 6u);
+    EXPECT_EQ(answers[0].dump(),
+              "{\"question\":\"What is off-screen?\",\"answer\":[\"frustum culling removed 3 objects (100 triangles) "
+              "wholly outside the view\"]}");
+    EXPECT_EQ(answers[2]["answer"][0].dump(), "{\"not_analysed\":\"turned off by --no-detail\"}");
+    EXPECT_EQ(answers[5].dump(),
+              "{\"question\":\"What stands between a surface and a light?\",\"not_analysed\":\"no shadow rays in this report\"}");
+    // Change the stored answer: the page shows the report's words.
+    r["views"][0]["findings"]["answers"][0]["answer"][0] = "a <stored> answer";
+    const std::string html = va::reportHtml(r, "");
+    EXPECT_NE(html.find("What is off-screen?</span> a &lt;stored&gt; answer.</li>"), std::string::npos);
+    EXPECT_NE(html.find("What needs less detail?</span> <span class=\"muted\">not analysed</span> (turned off by "
+                        "--no-detail); 10 triangles of 100"),
+              std::string::npos);
 }

@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 // ---- A small JSON Schema validator (the subset docs/report-schema.json uses) ------------------
 // Keywords: $ref (local "#/$defs/NAME"), type (string or array), const, enum, pattern (ECMAScript,
 // searched), minimum, maximum, required, properties, additionalProperties (false or a schema),
-// items, minItems, maxItems.
+// items, minItems, maxItems, oneOf (exactly one alternative matches).
 
 bool typeMatches(const std::string &t, const Json &v) {
     if (t == "object") return v.is_object();
@@ -48,10 +48,21 @@ void validate(const Json &root, const Json &schema, const Json &v, const std::st
               std::vector<std::string> *errors) {
     static const std::vector<std::string> kKnown = {
         "$schema", "$id", "title", "description", "$ref", "type", "const", "enum", "minimum", "maximum", "required",
-        "properties", "additionalProperties", "items", "minItems", "maxItems", "$defs", "pattern"};
+        "properties", "additionalProperties", "items", "minItems", "maxItems", "$defs", "pattern", "oneOf"};
     for (auto it = schema.begin(); it != schema.end(); ++it)
         if (std::find(kKnown.begin(), kKnown.end(), it.key()) == kKnown.end())
             errors->push_back(where + ": validator does not know keyword '" + it.key() + "'");
+    // oneOf: the value matches exactly one of the alternatives.
+    if (schema.contains("oneOf")) {
+        int matches = 0;
+        for (const Json &alt : schema["oneOf"]) {
+            std::vector<std::string> altErrors;
+            validate(root, alt, v, where, &altErrors);
+            matches += altErrors.empty();
+        }
+        if (matches != 1)
+            errors->push_back(where + ": matches " + std::to_string(matches) + " of oneOf's alternatives, not exactly one");
+    }
     if (schema.contains("$ref")) {
         const std::string ref = schema["$ref"];
         const std::string prefix = "#/$defs/";
