@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <map>
 #include <mutex>
 
 #include <tbb/global_control.h>
@@ -256,6 +257,33 @@ void runZFightAudit(ViewContext &c, const ClipResult &clip) {
     r.zfightRan = true;
 }
 }  // namespace
+
+// The depth-resolution curves the report plots for each view's near and far (docs/depth-formats.md):
+// one audit per distinct (near, far, formats), in the order the views first use them.
+static void addDepthCurves(AnalysisResult *out) {
+    std::map<std::pair<std::pair<double, double>, std::string>, int> seen;
+    for (ViewResult &v : out->views) {
+        const double nearZ = v.spec.camera.nearZ, farZ = v.spec.camera.farZ;
+        std::string err;
+        if (!validateDepthAuditRange(nearZ, farZ, &err)) continue;
+        // The formats of the view's z-fighting table, in its order (the default twelve without one).
+        std::vector<DepthFormatSpec> specs;
+        if (v.zfightRan)
+            for (const ZFightFormatStats &f : v.zfight.perFormat) specs.push_back(f.format);
+        if (specs.empty()) specs.assign(defaultZFightFormats().begin(), defaultZFightFormats().end());
+        std::string names;
+        for (const DepthFormatSpec &f : specs) names += depthFormatName(f) + ",";
+        const auto key = std::make_pair(std::make_pair(nearZ, farZ), names);
+        auto it = seen.find(key);
+        if (it == seen.end()) {
+            DepthAuditResult curves = auditDepthFormats(nearZ, farZ, specs);
+            if (!curves.error.empty()) continue;
+            it = seen.emplace(key, int(out->depthCurves.size())).first;
+            out->depthCurves.push_back(std::move(curves));
+        }
+        v.depthCurve = it->second;
+    }
+}
 
 PreparedScene prepareScene(const Scene &scene) {
     PreparedScene ps;
@@ -544,6 +572,7 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         *err = firstErr;
         return false;
     }
+    addDepthCurves(out);
     return true;
 }
 

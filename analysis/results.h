@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/audits/audit.h"
+#include "analysis/audits/depth_audit.h"
 #include "analysis/stages/cells.h"
 #include "analysis/audits/detail.h"
 #include "analysis/stages/grid.h"
@@ -96,6 +97,10 @@ struct ViewResult {
     std::string zfightReason;         // why it did not run
     ZFightResult zfight;
     double zfightMs = 0;
+    // The depth-resolution curves of this view's near and far (AnalysisResult::depthCurves; the
+    // page's plot), for the formats of its z-fighting table (the default twelve when it did not run);
+    // -1: none (a near/far the depth audit refuses).
+    int depthCurve = -1;
     double totalMs = 0;
 };
 
@@ -178,6 +183,9 @@ struct AnalysisResult {
         size_t viewsTotal = 0;        // views before the selection
     } shard;
     std::vector<ViewResult> views;
+    // Depth resolution against view depth per format, one set per distinct (near, far, formats), in
+    // the order the views first use them (ViewResult::depthCurve); computed once per set.
+    std::vector<DepthAuditResult> depthCurves;
 };
 
 }  // namespace va

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "render/depth_format.h"
 #include "reports/depth_plot.h"
 #include "reports/html_parts.h"
 
@@ -111,18 +112,36 @@ std::string scatterSvg(const std::vector<ScatterPoint> &pts, const std::string &
 // near/far (analysis/audits/depth_audit.h: the formats' exact arithmetic, the same curves as
 // `visaudit depth-audit`); the view's own format drawn thick, dashed markers at the hotspots'
 // depths. Colors are depthPlotColor's (the same as depth-audit.png).
-std::string resolutionSvg(const DepthAuditResult &r, const std::string &ownFormat,
+std::string resolutionSvg(const Json *curve, const std::string &ownFormat,
                           const std::vector<std::pair<std::string, double>> &markers, const std::string &id) {
+    // The curve set as the report stores it: depths, and per format its resolution at each depth
+    // (null where the format does not represent the depth).
+    const Json *depthsJson = get(curve, "depths"), *formats = get(curve, "formats");
+    const auto nearZ = num(curve, {"near"}), farZ = num(curve, {"far"});
+    if (!depthsJson || !depthsJson->is_array() || !formats || !formats->is_array() || !nearZ || !farZ) return {};
+    std::vector<double> depths;
+    for (const Json &d : *depthsJson) depths.push_back(d.is_number() ? d.get<double>() : NAN);
+    struct Series {
+        std::string name;
+        std::vector<std::optional<double>> resolution;
+    };
+    std::vector<Series> series;
+    for (const Json &f : *formats) {
+        Series s{str(get(&f, "name")), {}};
+        if (const Json *res = get(&f, "resolution"); res && res->is_array())
+            for (const Json &v : *res) s.resolution.push_back(num(&v));
+        series.push_back(std::move(s));
+    }
     double yLo = INFINITY, yHi = 0;
-    for (const DepthFormatAudit &f : r.formats)
-        for (const auto &v : f.curveResolution)
+    for (const Series &f : series)
+        for (const auto &v : f.resolution)
             if (v && *v > 0 && std::isfinite(*v)) {
                 yLo = std::min(yLo, *v);
                 yHi = std::max(yHi, *v);
             }
-    if (!(yHi > 0) || r.curveDepths.empty()) return {};
+    if (!(yHi > 0) || depths.empty()) return {};
     const double dLo = std::floor(std::log10(yLo)), dHi = std::max(dLo + 1, std::ceil(std::log10(yHi)));
-    const double xLo = std::log10(r.nearZ), xHi = std::log10(r.farZ);
+    const double xLo = std::log10(*nearZ), xHi = std::log10(*farZ);
     const double L = 70, R = 640, T = 12, B = 300;
     const auto X = [&](double d) { return L + (R - L) * (std::log10(d) - xLo) / (xHi - xLo); };
     const auto Y = [&](double res) { return B - (B - T) * (std::log10(res) - dLo) / (dHi - dLo); };
@@ -142,29 +161,30 @@ std::string resolutionSvg(const DepthAuditResult &r, const std::string &ownForma
              fx(Y(std::pow(10, e))) + "\"/><text class=\"muted\" text-anchor=\"end\" x=\"" + fx(L - 5) + "\" y=\"" +
              fx(Y(std::pow(10, e)) + 4) + "\">1e" + std::to_string(int(e)) + "</text>";
     o += "<text text-anchor=\"middle\" x=\"" + fx((L + R) / 2) + "\" y=\"" + fx(B + 34) + "\">view depth (m), near " +
-         fmtReal(r.nearZ) + " to far " + fmtReal(r.farZ) + "</text>";
+         fmtReal(*nearZ) + " to far " + fmtReal(*farZ) + "</text>";
     o += "<text text-anchor=\"middle\" transform=\"translate(14 " + fx((T + B) / 2) + ") rotate(-90)\">resolution (m)</text>";
     for (const auto &[name, depth] : markers) {
-        if (!(depth >= r.nearZ && depth <= r.farZ)) continue;
+        if (!(depth >= *nearZ && depth <= *farZ)) continue;
         o += "<line class=\"mark\" x1=\"" + fx(X(depth)) + "\" y1=\"" + fx(T) + "\" x2=\"" + fx(X(depth)) + "\" y2=\"" +
              fx(B) + "\"><title>hotspot " + esc(name) + " at " + fmtReal(depth) + " m</title></line>";
         o += "<text class=\"marklabel\" x=\"" + fx(X(depth) + 3) + "\" y=\"" + fx(T + 10) + "\">" + esc(name) + "</text>";
     }
     int legendRow = 0;
-    for (const DepthFormatAudit &f : r.formats) {
-        const Rgb8 c = depthPlotColor(f.format);
+    for (const Series &f : series) {
+        DepthFormatSpec spec;
+        const Rgb8 c = parseDepthFormat(f.name, &spec, nullptr) ? depthPlotColor(spec) : Rgb8{128, 128, 128};
         char color[16];
         std::snprintf(color, sizeof color, "#%02x%02x%02x", c.r, c.g, c.b);
         const bool own = f.name == ownFormat;
         std::string d;  // one path, broken ("M") where a sample is absent
         bool pen = false;
-        for (size_t i = 0; i < r.curveDepths.size() && i < f.curveResolution.size(); ++i) {
-            const auto &v = f.curveResolution[i];
+        for (size_t i = 0; i < depths.size() && i < f.resolution.size(); ++i) {
+            const auto &v = f.resolution[i];
             if (!v || !(*v > 0) || !std::isfinite(*v)) {
                 pen = false;
                 continue;
             }
-            d += (pen ? "L" : "M") + fx(X(r.curveDepths[i])) + " " + fx(Y(*v));
+            d += (pen ? "L" : "M") + fx(X(depths[i])) + " " + fx(Y(*v));
             pen = true;
         }
         o += "<path fill=\"none\" stroke=\"" + std::string(color) + "\" stroke-width=\"" + (own ? "3.5" : "1.5") + "\" d=\"" +

@@ -17,7 +17,6 @@
 #include <utility>
 #include <vector>
 
-#include "analysis/audits/depth_audit.h"
 #include "reports/report_read.h"
 #include "reports/text_format.h"
 
@@ -89,9 +88,9 @@ struct ScatterPoint {
 // A scatter of time (x, ms) against error (y, pixels), linear axes from 0, labelled points.
 std::string scatterSvg(const std::vector<ScatterPoint> &pts, const std::string &id, const std::string &xTitle,
                        const std::string &yTitle);
-// Depth resolution against view depth, every format of `r`, `ownFormat` drawn bold; markers are
-// labelled depths (hotspots).
-std::string resolutionSvg(const DepthAuditResult &r, const std::string &ownFormat,
+// Depth resolution against view depth, every format of a report's depth curve set
+// (report.depth_curves[k]), `ownFormat` drawn bold; markers are labelled depths (hotspots).
+std::string resolutionSvg(const Json *curve, const std::string &ownFormat,
                           const std::vector<std::pair<std::string, double>> &markers, const std::string &id);
 
 // ---- The page (html.cpp, html_view.cpp) ------------------------------------------------------------
@@ -108,7 +107,6 @@ struct HtmlWriter {
     Folder folder;
     std::vector<const Json *> views = viewsOf(report);
     std::vector<size_t> worstFirst = worstFirstOf(report, views.size());
-    std::map<std::pair<std::pair<double, double>, std::string>, DepthAuditResult> audits;  // by (near, far), formats
     std::string o;
 
     void header();

@@ -394,28 +394,16 @@ void HtmlWriter::depthFormats(const Json *v, const std::string &id) {
     } else {
         o += "<p class=\"note\">Z-fighting per format not analysed" + (d ? ": " + esc(str(get(d, "reason"))) : std::string()) + ".</p>";
     }
-    // The resolution plot for this view's near/far.
-    const auto nearZ = num(v, {"camera", "near"}), farZ = num(v, {"camera", "far"});
-    std::string err;
-    if (!nearZ || !farZ || !validateDepthAuditRange(*nearZ, *farZ, &err)) return;
-    // The formats the view's z-fighting table holds (default: the classic twelve), in its order.
-    std::vector<DepthFormatSpec> specs;
-    std::string names;
-    if (fmts && fmts->is_object())
-        for (auto f = fmts->begin(); f != fmts->end(); ++f) {
-            DepthFormatSpec spec;
-            if (parseDepthFormat(f.key(), &spec, nullptr)) specs.push_back(spec), names += f.key() + ",";
-        }
-    if (specs.empty()) specs.assign(defaultZFightFormats().begin(), defaultZFightFormats().end());
-    auto key = std::make_pair(std::make_pair(*nearZ, *farZ), names);
-    auto it = audits.find(key);
-    if (it == audits.end()) it = audits.emplace(key, auditDepthFormats(*nearZ, *farZ, specs)).first;
-    if (!it->second.error.empty()) return;
+    // The resolution plot for this view's near/far (report.depth_curves, computed by the analysis).
+    const Json *curves = get(&report, "depth_curves");
+    const auto k = num(v, {"depth_curve"});
+    if (!curves || !curves->is_array() || !k || !(*k >= 0 && *k < double(curves->size()))) return;
+    const Json *curve = &(*curves)[size_t(*k)];
     std::vector<std::pair<std::string, double>> markers;
     if (const Json *hs = get(d, "hotspots"); hs && hs->is_array())
         for (const Json &h : *hs)
             if (auto dep = num(get(&h, "depth")); dep && markers.size() < 12) markers.emplace_back("#" + fmtValue(get(&h, "id")), *dep);
-    const std::string svg = resolutionSvg(it->second, own, markers, id + "-resolution");
+    const std::string svg = resolutionSvg(curve, own, markers, id + "-resolution");
     if (svg.empty()) return;
     o += "<p class=\"note\">Depth resolution (the distance between two adjacent stored values) against view depth for "
          "this view's near and far planes, every format; lower is finer. Dashed lines: the hotspots' depths.</p>" + svg;

@@ -145,7 +145,7 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
 
     Json m;
     for (const auto &[key, value] : first.items()) {
-        if (key == "views" || key == "totals" || key == "findings") continue;
+        if (key == "views" || key == "totals" || key == "findings" || key == "depth_curves") continue;
         m[key] = value;
     }
     m["shard"] = {{"index", 1}, {"count", 1}, {"views_total", total}};
@@ -161,8 +161,23 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
             }
             value = finite ? Json(sum) : Json(nullptr);
         }
-    Json list = Json::array();
-    for (const Json *v : views) list.push_back(*v);
+    // The depth curves: each view's set from its shard, renumbered in the order the merged views
+    // first use them (what a single run numbers).
+    Json curves = Json::array(), list = Json::array();
+    std::map<std::string, size_t> curveIndex;  // a set's JSON text -> its merged index
+    for (size_t idx = 0; idx < total; ++idx) {
+        Json v = *views[idx];
+        const Json &shardCurves = reports[owner[idx]]["depth_curves"];
+        if (v.contains("depth_curve") && v["depth_curve"].is_number_unsigned() && shardCurves.is_array() &&
+            v["depth_curve"].get<size_t>() < shardCurves.size()) {
+            const Json &c = shardCurves[v["depth_curve"].get<size_t>()];
+            auto [it, added] = curveIndex.emplace(c.dump(), curves.size());
+            if (added) curves.push_back(c);
+            v["depth_curve"] = it->second;
+        }
+        list.push_back(std::move(v));
+    }
+    if (first.contains("depth_curves")) m["depth_curves"] = curves;
     m["views"] = list;
     m["totals"] = reportTotals(m["views"]);
     addFindings(&m);

@@ -429,6 +429,18 @@ Json viewImagesJson(const ViewResult &v, const ViewImageNames &names, ImageSet i
     return im;
 }
 
+// "depth_curves": resolution against view depth per format, for the page's plot of each view's
+// near and far (analysis/pipeline.cpp addDepthCurves; docs/depth-formats.md).
+Json depthCurvesJson(const std::vector<DepthAuditResult> &curves) {
+    Json a = Json::array();
+    for (const DepthAuditResult &c : curves) {
+        Json formats = Json::array();
+        for (const DepthFormatAudit &f : c.formats) formats.push_back({{"name", f.name}, {"resolution", json::value(f.curveResolution)}});
+        a.push_back({{"near", num(c.nearZ)}, {"far", num(c.farZ)}, {"depths", json::value(c.curveDepths)}, {"formats", formats}});
+    }
+    return a;
+}
+
 // One view's entry of "views".
 Json viewJson(const ViewResult &v, const std::string &base, const std::vector<std::string> &lightNames,
               ImageSet images) {
@@ -469,6 +481,7 @@ Json viewJson(const ViewResult &v, const std::string &base, const std::vector<st
     else
         vj["depth"] = {{"ran", false}, {"reason", v.zfightReason}};
     vj["images"] = viewImagesJson(v, names, images);
+    vj["depth_curve"] = v.depthCurve >= 0 ? Json(uint64_t(v.depthCurve)) : Json(nullptr);
     vj["total_ms"] = num(v.totalMs);
     return vj;
 }
@@ -484,6 +497,7 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
     preparedJson(r, j);
     j["shard"] = {{"index", r.shard.index}, {"count", r.shard.count},
                   {"views_total", r.shard.viewsTotal ? r.shard.viewsTotal : r.views.size()}};
+    j["depth_curves"] = depthCurvesJson(r.depthCurves);
     const std::vector<std::string> bases = imageBaseNames(r.views);
     Json views = Json::array();
     for (size_t i = 0; i < r.views.size(); ++i) views.push_back(viewJson(r.views[i], bases[i], r.lightNames, images));
