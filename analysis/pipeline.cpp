@@ -152,6 +152,7 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     ViewResult &r = c.r;
     if (!ps.rays) {
         r.stages.push_back(skipped("raycast", "turned off by --no-raycast"));
+        r.raycast.skip("turned off by --no-raycast");
         return;
     }
     const Stopwatch t0;
@@ -161,12 +162,13 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     opt.planes = scene.planes.data();
     opt.tiesToLowestId = true;
     opt.keepBarycentrics = ps.effects.tracesRays();
-    r.raycastImage = ps.rays->castPrimary(c.cam, opt, &r.raycast);
-    r.raycastRan = true;
+    r.raycast = RaycastResult{};
+    RaycastResult &ray = *r.raycast;
+    ray.image = ps.rays->castPrimary(c.cam, opt, &ray.stats);
     const uint64_t in = scene.objectTriangles.size();
     uint64_t hit = 0;
     std::vector<uint8_t> seen(scene.triangleCount(), 0);
-    for (uint32_t id : r.raycastImage.id)
+    for (uint32_t id : ray.image.id)
         if (id && !seen[id - 1]) {
             seen[id - 1] = 1;
             ++hit;
@@ -177,7 +179,7 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
     for (uint32_t t : lists.triangles) outOfSet[t] = 0;
     uint64_t culledPixels = 0;
-    for (uint32_t id : r.raycastImage.id) culledPixels += id && outOfSet[id - 1];
+    for (uint32_t id : ray.image.id) culledPixels += id && outOfSet[id - 1];
     RaycastImage sameSet;
     if (culledPixels > 0) {
         PrimaryOptions same = opt;
@@ -187,15 +189,13 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     }
     // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
     r.stages.push_back(ran("raycast", in, in - hit, hit, t0.ms()));
-    const RaycastImage &compared = culledPixels > 0 ? sameSet : r.raycastImage;
-    r.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, c.cam,
+    const RaycastImage &compared = culledPixels > 0 ? sameSet : ray.image;
+    ray.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, c.cam,
                               makeDepthEncoder(c.view.depthFormat, c.cam.nearZ, c.cam.farZ), ps.rays->origin());
-    r.crossCheck.culled = culledPixels;
-    r.crossCheck.recast = culledPixels > 0;
-    if (ps.effects.tracesRays() && !c.stopped()) {
-        r.effects = traceEffects(*ps.rays, c.cam, r.raycastImage, effectsInputFor(ps.effectsData, ps.effects));
-        r.effectsRan = true;
-    }
+    ray.crossCheck.culled = culledPixels;
+    ray.crossCheck.recast = culledPixels > 0;
+    if (!ps.effects.tracesRays()) r.effects.skip("the scene calls for no secondary rays");
+    else if (!c.stopped()) r.effects = traceEffects(*ps.rays, c.cam, ray.image, effectsInputFor(ps.effectsData, ps.effects));
 }
 
 // ---- Audits -------------------------------------------------------------------------------------
@@ -204,7 +204,7 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
 void runCullingAudit(ViewContext &c, const TriangleLists &lists, std::vector<uint32_t> &fragmentsPerSource) {
     ViewResult &r = c.r;
     if (!c.s.audit) {
-        r.auditReason = "turned off by --no-audit";
+        r.audit.skip("turned off by --no-audit");
         return;
     }
     const Stopwatch t0;
@@ -212,28 +212,28 @@ void runCullingAudit(ViewContext &c, const TriangleLists &lists, std::vector<uin
     // up to 4 per pixel (48 bytes a pixel; estimateMemory), above which it rasterizes again.
     const uint64_t pixels = uint64_t(std::max(c.cam.width, 0)) * uint64_t(std::max(c.cam.height, 0));
     const uint64_t cache = c.ps.bspTree ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
-    r.reference = referenceVisibility(c.scene, c.cam, cache);
-    r.cullAudit = auditCulling(c.scene, r.reference, c.culls, lists.triangles, &fragmentsPerSource, &c.cam);
+    r.audit = CullingAuditResult{};
+    CullingAuditResult &a = *r.audit;
+    a.reference = referenceVisibility(c.scene, c.cam, cache);
+    a.cull = auditCulling(c.scene, a.reference, c.culls, lists.triangles, &fragmentsPerSource, &c.cam);
     // A map's PVS: the evidence of each false cull it made (camera leaf and cluster, faces, leafs,
     // clusters, PVS bits, distances), for a reader to check against the map's bytes.
     if (hasPvs(c.scene) && !hasPortals(c.scene) && c.s.cells)
         for (size_t k = 0; k < c.culls.size(); ++k)
-            if (c.culls[k].stage == "cells") r.pvsEvidence = pvsEvidence(c.scene, c.cam, r.cells, r.reference, r.cullAudit, k);
-    r.auditMs = t0.ms();
-    r.auditRan = true;
+            if (c.culls[k].stage == "cells") a.pvsEvidence = pvsEvidence(c.scene, c.cam, r.cells, a.reference, a.cull, k);
+    a.ms = t0.ms();
 }
 
 // Draw orders against the reference -- painter's, BSP, scanline, overdraw by order, and the
 // A-buffer where the scene has transparency.
 void runOrderingAudit(ViewContext &c) {
     ViewResult &r = c.r;
-    if (c.ps.bspTree && r.auditRan) {
+    if (c.ps.bspTree && r.audit.ran()) {
         OrderingSettings os = c.s.orderingSettings;
         os.abufferMaxList = c.s.limits.maxABufferList;
-        r.ordering = analyzeOrdering(c.scene, c.cam, r.reference, *c.ps.bspTree, c.ps.effects.abuffer, os);
-        r.orderingRan = true;
+        r.ordering = analyzeOrdering(c.scene, c.cam, r.audit->reference, *c.ps.bspTree, c.ps.effects.abuffer, os);
     } else {
-        r.orderingReason = c.ps.orderingReason.empty() ? "needs the reference visibility" : c.ps.orderingReason;
+        r.ordering.skip(c.ps.orderingReason.empty() ? "needs the reference visibility" : c.ps.orderingReason);
     }
 }
 
@@ -242,7 +242,7 @@ void runOrderingAudit(ViewContext &c) {
 void runZFightAudit(ViewContext &c, const ClipResult &clip) {
     ViewResult &r = c.r;
     if (!c.s.zfight) {
-        r.zfightReason = "turned off by --no-zfight";
+        r.zfight.skip("turned off by --no-zfight");
         return;
     }
     const Stopwatch t0;
@@ -253,8 +253,7 @@ void runZFightAudit(ViewContext &c, const ClipResult &clip) {
         zs.formats.size() < 32)
         zs.formats.push_back(c.view.depthFormat);
     r.zfight = analyzeZFighting(c.scene, c.cam, clip.out, zs);
-    r.zfightMs = t0.ms();
-    r.zfightRan = true;
+    r.zfight->ms = t0.ms();
 }
 }  // namespace
 
@@ -268,8 +267,8 @@ static void addDepthCurves(AnalysisResult *out) {
         if (!validateDepthAuditRange(nearZ, farZ, &err)) continue;
         // The formats of the view's z-fighting table, in its order (the default twelve without one).
         std::vector<DepthFormatSpec> specs;
-        if (v.zfightRan)
-            for (const ZFightFormatStats &f : v.zfight.perFormat) specs.push_back(f.format);
+        if (v.zfight.ran())
+            for (const ZFightFormatStats &f : v.zfight->perFormat) specs.push_back(f.format);
         if (specs.empty()) specs.assign(defaultZFightFormats().begin(), defaultZFightFormats().end());
         std::string names;
         for (const DepthFormatSpec &f : specs) names += depthFormatName(f) + ",";
@@ -368,14 +367,14 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     runOrderingAudit(c);
     // The reference's screen triangles and fragments served the ordering audit only: a finished
     // view keeps neither (estimateMemory's finishedViews).
-    r.reference.fragmentCache = FragmentCache{};
-    r.reference.screen = ScreenTriangles{};
+    if (r.audit.ran()) {
+        r.audit->reference.fragmentCache = FragmentCache{};
+        r.audit->reference.screen = ScreenTriangles{};
+    }
     // Detail: triangles drawn against the pixels they show, too small, over-detailed.
     if (c.stopped()) return r;
-    if (s.detail) {
-        r.detail = auditDetail(c.scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
-        r.detailRan = true;
-    }
+    if (s.detail) r.detail = auditDetail(c.scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
+    else r.detail.skip("turned off by --no-detail");
     if (c.stopped()) return r;
     runZFightAudit(c, clip);
     r.totalMs = tView.ms();
@@ -562,9 +561,9 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         ViewResult v = analyzeView(ps, resolved[i], cams[i], s);
         if (stopped()) return failWith(kInterrupted);
         std::string e;
-        if (v.effectsRan && !v.effects.ok) return failWith("view '" + v.spec.name + "': effects: " + v.effects.error);
-        if (v.orderingRan && !v.ordering.abuffer.error.empty())
-            return failWith("view '" + v.spec.name + "': " + v.ordering.abuffer.error);
+        if (v.effects.ran() && !v.effects->ok) return failWith("view '" + v.spec.name + "': effects: " + v.effects->error);
+        if (v.ordering.ran() && !v.ordering->abuffer.error.empty())
+            return failWith("view '" + v.spec.name + "': " + v.ordering->abuffer.error);
         if (onView && !onView(i, v, &e)) return failWith(e);
         out->views[i] = std::move(v);
     });

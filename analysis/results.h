@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <variant>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,63 @@ struct BackfaceStats {
     uint64_t edgeOn = 0;              // plane exactly 0 at the eye (counted among culled)
 };
 
+// A stage or audit that may not run for a view: its result when it ran, else why it did not
+// (docs/architecture.md, "The stage contract"). One value: never a flag and a reason kept apart.
+template <class T>
+class Ran {
+public:
+    Ran() = default;
+    Ran &operator=(T result) {
+        v_ = std::move(result);
+        return *this;
+    }
+    void skip(std::string reason) { v_ = Skipped{std::move(reason)}; }
+    bool ran() const { return std::holds_alternative<T>(v_); }
+    // Why it did not run ("" when it ran).
+    const std::string &reason() const {
+        static const std::string none;
+        const Skipped *s = std::get_if<Skipped>(&v_);
+        return s ? s->reason : none;
+    }
+    // The result; only when ran().
+    T &operator*() { return std::get<T>(v_); }
+    const T &operator*() const { return std::get<T>(v_); }
+    T *operator->() { return &std::get<T>(v_); }
+    const T *operator->() const { return &std::get<T>(v_); }
+
+private:
+    struct Skipped {
+        std::string reason;
+    };
+    std::variant<Skipped, T> v_{Skipped{"not run"}};
+};
+
+// The raycast stage: Embree primary rays at pixel centers over the whole scene (no culling),
+// cross-checked pixel by pixel against the z-buffer (docs/audits.md).
+struct RaycastResult {
+    RaycastStats stats;
+    CrossCheck crossCheck;
+    RaycastImage image;               // ids/depths for NAME.raycast.ids.exr (released after writing)
+    void releasePixels() {
+        image = RaycastImage{};
+        std::vector<uint8_t>().swap(crossCheck.cls);
+    }
+};
+
+// The audit against the reference visibility (docs/audits.md).
+struct CullingAuditResult {
+    ReferenceVisibility reference;
+    CullAudit cull;
+    PvsEvidence pvsEvidence;          // a map's PVS: the evidence of its false culls (pvs_evidence.h)
+    double ms = 0;
+    void releasePixels() {
+        std::vector<uint32_t>().swap(reference.id);
+        std::vector<double>().swap(reference.depth);
+        std::vector<uint32_t>().swap(reference.pixelsOf);
+        std::vector<uint8_t>().swap(cull.fate);
+    }
+};
+
 struct ViewResult {
     size_t index = 0;                 // position in the full view list (before --shard selection)
     std::string imageBase;            // file-name base of its images (empty: derived from the name)
@@ -72,69 +130,29 @@ struct ViewResult {
     std::string cellsNote;            // e.g. the camera is in the void
     GridStats grid;                   // the grid stage, when it ran
     OcclusionStats occlusion;         // the occlusion stage, when it ran
-    bool orderingRan = false;         // draw orders and exact orders (docs/ordering.md)
-    std::string orderingReason;       // why it did not run
-    OrderingResult ordering;
-    bool detailRan = false;           // the detail audit (docs/coarse-stages.md)
-    DetailResult detail;
-    // The raycast stage: Embree primary rays at pixel centers over the whole scene (no culling),
-    // cross-checked pixel by pixel against the z-buffer; secondary rays where the plan says.
-    bool raycastRan = false;
-    RaycastStats raycast;
-    CrossCheck crossCheck;
-    RaycastImage raycastImage;        // ids/depths for NAME.raycast.ids.exr (released after writing)
-    bool effectsRan = false;
-    EffectsResult effects;
-    // Audit against the reference visibility (docs/audits.md): per-pixel buffers are released once
-    // the images are written.
-    bool auditRan = false;
-    std::string auditReason;          // why it did not run
-    ReferenceVisibility reference;
-    CullAudit cullAudit;
-    PvsEvidence pvsEvidence;          // a map's PVS: the evidence of its false culls (pvs_evidence.h)
-    double auditMs = 0;
-    bool zfightRan = false;           // the per-view z-fighting analysis (docs/zfighting.md)
-    std::string zfightReason;         // why it did not run
-    ZFightResult zfight;
-    double zfightMs = 0;
+    Ran<RaycastResult> raycast;       // and its secondary rays where the plan says (effects)
+    Ran<EffectsResult> effects;
+    Ran<CullingAuditResult> audit;
+    Ran<OrderingResult> ordering;     // draw orders and exact orders (docs/ordering.md)
+    Ran<DetailResult> detail;         // the detail audit (docs/coarse-stages.md)
+    Ran<ZFightResult> zfight;         // the per-view z-fighting analysis (docs/zfighting.md)
     // The depth-resolution curves of this view's near and far (AnalysisResult::depthCurves; the
     // page's plot), for the formats of its z-fighting table (the default twelve when it did not run);
     // -1: none (a near/far the depth audit refuses).
     int depthCurve = -1;
     double totalMs = 0;
+
+    // Frees every per-pixel buffer once the images are written; what the report reads (the
+    // statistics, hotspot and offender lists) stays. Each result frees its own buffers.
+    void releasePixelBuffers() {
+        buffer = ZBuffer{};
+        if (raycast.ran()) raycast->releasePixels();
+        if (effects.ran()) effects->releasePixels();
+        if (audit.ran()) audit->releasePixels();
+        if (ordering.ran()) ordering->releasePixels();
+        if (zfight.ran()) zfight->releasePixels();
+    }
 };
-
-// Frees a vector's memory. (`v = {}` only empties it: it assigns from an empty initializer list,
-// which keeps the capacity -- the per-pixel buffers of every finished view stayed allocated that way.)
-template <class T>
-void freeMemory(std::vector<T> &v) {
-    std::vector<T>().swap(v);
-}
-
-// Frees every per-pixel buffer of a view once its images are written; what the report reads (the
-// statistics, hotspot and offender lists) stays.
-inline void releasePixelBuffers(ViewResult &v) {
-    v.buffer = ZBuffer{};
-    freeMemory(v.ordering.painter.id);
-    freeMemory(v.ordering.painter.cls);
-    freeMemory(v.ordering.bsp.id);
-    freeMemory(v.ordering.bsp.cls);
-    freeMemory(v.ordering.scanline.id);
-    freeMemory(v.ordering.abuffer.rgb);
-    freeMemory(v.ordering.abuffer.edge);
-    freeMemory(v.reference.id);
-    freeMemory(v.reference.depth);
-    freeMemory(v.reference.pixelsOf);
-    freeMemory(v.cullAudit.fate);
-    freeMemory(v.zfight.pixelClass);
-    freeMemory(v.zfight.fightMask);
-    freeMemory(v.zfight.hotspotOf);
-    v.raycastImage = RaycastImage{};
-    freeMemory(v.crossCheck.cls);
-    freeMemory(v.effects.shadowMask);
-    freeMemory(v.effects.secondaryDepth);
-    freeMemory(v.effects.secondaryRays);
-}
 
 struct AnalysisResult {
     std::string scenePath;

@@ -199,7 +199,7 @@ int analyzeToReport(const AnalyzeOptions &o,
         const Stopwatch w0;
         if (!writeViewImages(v, out.staging(), bases[i], e, imageSet)) return false;
         imagesMs[i] = w0.ms();
-        releasePixelBuffers(v);  // the images hold them now
+        v.releasePixelBuffers();  // the images hold them now
         const int k = ++done;
         if (!o.quiet) {
             // A terminal gets one line rewritten in place with an estimate of the time left; a log

@@ -79,6 +79,12 @@ struct EffectsResult {
     std::vector<std::vector<uint64_t>> shadowMask;
     std::vector<uint8_t> secondaryDepth;  // per pixel: deepest secondary ray traced (0 = none)
     std::vector<uint16_t> secondaryRays;  // per pixel: reflection + refraction rays traced (saturates)
+    // Frees the per-pixel buffers once the images are written (the statistics stay).
+    void releasePixels() {
+        std::vector<std::vector<uint64_t>>().swap(shadowMask);
+        std::vector<uint8_t>().swap(secondaryDepth);
+        std::vector<uint16_t>().swap(secondaryRays);
+    }
 
     bool shadowed(size_t light, int x, int y) const {
         return (shadowMask[light][size_t(y) * maskStride + size_t(x >> 6)] >> (x & 63)) & 1u;

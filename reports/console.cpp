@@ -116,7 +116,8 @@ std::string zfightViewsTable(const std::string &scenePath, const AnalysisResult 
     s += format("z-fighting per view of %s (pixels whose two nearest surfaces fight; coplanar ones in brackets)\n",
                 scenePath.c_str());
     for (const ViewResult &v : result.views) {
-        const ZFightResult &z = v.zfight;
+        if (!v.zfight.ran()) continue;
+        const ZFightResult &z = *v.zfight;
         s += format("view '%s' %dx%d, near %g, far %g, its format %s: %llu hotspots\n", v.spec.name.c_str(),
                     v.camera.width, v.camera.height, v.camera.nearZ, v.camera.farZ,
                     depthFormatName(v.spec.depthFormat).c_str(), (unsigned long long)z.hotspotCount);

@@ -284,36 +284,36 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     }
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
-    if (view.zfightRan && want("zfight_png") && !writeZFightImage(view.zfight, zb, prefix + names.zfightPng, err)) return false;
+    if (view.zfight.ran() && want("zfight_png") && !writeZFightImage(*view.zfight, zb, prefix + names.zfightPng, err)) return false;
     // BASE.culling.png: the reference visibility colored by each pixel's fate (reports/audit_images.h).
-    if (view.auditRan && want("culling_png") && !writeCullingImage(view.reference, view.cullAudit, prefix + names.cullingPng, err))
+    if (view.audit.ran() && want("culling_png") && !writeCullingImage(view.audit->reference, view.audit->cull, prefix + names.cullingPng, err))
         return false;
     // Draw orders: painter's errors, overdraw by order, the A-buffer composite (reports/ordering_images.h).
-    if (view.orderingRan) {
+    if (view.ordering.ran() && view.audit.ran()) {
         const OrderingImageNames on = orderingImageNames(names.base);
         if (want("painter_errors_png") &&
-            !writePainterErrorsImage(view.reference, view.ordering.painter, prefix + on.painterErrorsPng, err))
+            !writePainterErrorsImage(view.audit->reference, view.ordering->painter, prefix + on.painterErrorsPng, err))
             return false;
         if (want("overdraw_order_png") &&
-            !writeOverdrawByOrderChart(view.ordering.overdrawByOrder, prefix + on.overdrawOrderPng, err))
+            !writeOverdrawByOrderChart(view.ordering->overdrawByOrder, prefix + on.overdrawOrderPng, err))
             return false;
-        if (view.ordering.abufferRan && want("abuffer_png") &&
-            !writeABufferImage(view.ordering.abuffer, prefix + on.abufferPng, err))
+        if (view.ordering->abufferRan && want("abuffer_png") &&
+            !writeABufferImage(view.ordering->abuffer, prefix + on.abufferPng, err))
             return false;
     }
     // The raycast stage: its ids, and where it disagrees with the z-buffer (reports/audit_images.h).
-    if (view.raycastRan) {
-        if (want("raycast_ids_exr") && !writeRaycastIds(view.raycastImage.width, view.raycastImage.height,
-                                                        view.raycastImage.id, prefix + names.raycastIdsExr, err))
+    if (view.raycast.ran()) {
+        const RaycastImage &image = view.raycast->image;
+        if (want("raycast_ids_exr") && !writeRaycastIds(image.width, image.height, image.id, prefix + names.raycastIdsExr, err))
             return false;
-        if (want("raycast_diff_png") && !writeRaycastDiffImage(zb, view.crossCheck, prefix + names.raycastDiffPng, err))
+        if (want("raycast_diff_png") && !writeRaycastDiffImage(zb, view.raycast->crossCheck, prefix + names.raycastDiffPng, err))
             return false;
     }
     // Secondary rays: one shadow image per light, the depth of the ray trees (reports/effects_images.h).
-    if (view.effectsRan) {
-        for (size_t l = 0; l < view.effects.lights.size() && want("shadow_png"); ++l)
-            if (!writeShadowImage(view.effects, l, zb, prefix + shadowImageName(names, l, view), err)) return false;
-        if (want("secondary_png") && !writeSecondaryImage(view.effects, zb, prefix + names.secondaryPng, err)) return false;
+    if (view.effects.ran()) {
+        for (size_t l = 0; l < view.effects->lights.size() && want("shadow_png"); ++l)
+            if (!writeShadowImage(*view.effects, l, zb, prefix + shadowImageName(names, l, view), err)) return false;
+        if (want("secondary_png") && !writeSecondaryImage(*view.effects, zb, prefix + names.secondaryPng, err)) return false;
     }
     return true;
 }

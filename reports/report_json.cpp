@@ -76,7 +76,7 @@ ViewImageNames viewImageNames(const std::string &baseName) {
 }
 
 std::string shadowImageName(const ViewImageNames &names, size_t light, const ViewResult &view) {
-    const std::vector<LightShadowStats> &lights = view.effects.lights;
+    const std::vector<LightShadowStats> &lights = view.effects->lights;
     std::string name = lights[light].name.empty() ? std::string() : sanitizeFileName(lights[light].name);
     bool repeated = false;
     for (size_t k = 0; k < lights.size(); ++k)
@@ -134,10 +134,10 @@ Json orderingJson(const OrderingResult &o) {
 Json raycastJson(const ViewResult &v, const std::vector<std::string> &lightNames) {
     Json j;
     j["ran"] = true;
-    j["cross_check"] = json::write(v.crossCheck);
-    if (v.effectsRan) {
-        j["effects"] = json::write(v.effects.stats);
-        j["lights"] = json::value(v.effects.lights);
+    j["cross_check"] = json::write(v.raycast->crossCheck);
+    if (v.effects.ran()) {
+        j["effects"] = json::write(v.effects->stats);
+        j["lights"] = json::value(v.effects->lights);
     }
     (void)lightNames;
     return j;
@@ -162,7 +162,7 @@ Json stageJson(const StageRecord &s, const ViewResult &v) {
         else if (s.name == "cells") own = cellsJson(v);
         else if (s.name == "grid") own = json::write(v.grid);
         else if (s.name == "occlusion") own = json::write(v.occlusion);
-        else if (s.name == "raycast") own = json::write(v.raycast);
+        else if (s.name == "raycast") own = json::write(v.raycast->stats);
         for (auto it = own.begin(); it != own.end(); ++it) j[it.key()] = it.value();
     }
     return j;
@@ -233,8 +233,8 @@ Json pvsEvidenceJson(const PvsEvidence &e) {
 
 // The audit against the reference visibility (analysis/audits/audit.h; docs/audits.md).
 Json auditJson(const ViewResult &v) {
-    const ReferenceVisibility &ref = v.reference;
-    const CullAudit &a = v.cullAudit;
+    const ReferenceVisibility &ref = v.audit->reference;
+    const CullAudit &a = v.audit->cull;
     Json j;
     j["ran"] = true;
     j["reference"] = json::write(ref);
@@ -250,7 +250,7 @@ Json auditJson(const ViewResult &v) {
                         {"beyond_far_plane_triangles", a.beyondFarPlaneTriangles},
                         {"beyond_far_plane_pixels", a.beyondFarPlanePixels},
                         {"by_stage", byStage}};
-    if (v.pvsEvidence.ran) j["pvs_evidence"] = pvsEvidenceJson(v.pvsEvidence);
+    if (v.audit->pvsEvidence.ran) j["pvs_evidence"] = pvsEvidenceJson(v.audit->pvsEvidence);
     j["wasted_draws"] = {{"drawn_triangles", a.drawnTriangles},
                          {"drawn_objects", a.drawnObjects},
                          {"triangles", a.wastedTriangles},
@@ -259,12 +259,12 @@ Json auditJson(const ViewResult &v) {
                          {"fragments", a.wastedFragments},
                          {"share", a.drawnTriangles ? double(a.wastedTriangles) / double(a.drawnTriangles) : 0.0}};
     j["unaccounted_pixels"] = a.unaccountedPixels;
-    j["ms"] = num(v.auditMs);
+    j["ms"] = num(v.audit->ms);
     return j;
 }
 
 // The per-view z-fighting analysis (analysis/audits/zfight.h; docs/zfighting.md).
-Json depthJson(const ZFightResult &z, double ms) {
+Json depthJson(const ZFightResult &z) {
     Json j;
     j["ran"] = true;
     j["covered_pixels"] = z.coveredPixels;
@@ -308,7 +308,7 @@ Json depthJson(const ZFightResult &z, double ms) {
                       {"why", h.why}});
     }
     j["hotspots"] = hs;
-    j["ms"] = num(ms);
+    j["ms"] = num(z.ms);
     return j;
 }
 
@@ -399,22 +399,22 @@ Json viewImagesJson(const ViewResult &v, const ViewImageNames &names, ImageSet i
                {"depth_png", names.depthPng},
                {"overdraw_png", names.overdrawPng},
                {"ids_exr", names.idsExr}};
-    if (v.zfightRan) im["zfight_png"] = names.zfightPng;
-    if (v.auditRan) im["culling_png"] = names.cullingPng;
-    if (v.orderingRan) {
+    if (v.zfight.ran()) im["zfight_png"] = names.zfightPng;
+    if (v.audit.ran()) im["culling_png"] = names.cullingPng;
+    if (v.ordering.ran()) {
         const OrderingImageNames on = orderingImageNames(names.base);
         im["painter_errors_png"] = on.painterErrorsPng;
         im["overdraw_order_png"] = on.overdrawOrderPng;
-        if (v.ordering.abufferRan) im["abuffer_png"] = on.abufferPng;
+        if (v.ordering->abufferRan) im["abuffer_png"] = on.abufferPng;
     }
-    if (v.raycastRan) {
+    if (v.raycast.ran()) {
         im["raycast_ids_exr"] = names.raycastIdsExr;
         im["raycast_diff_png"] = names.raycastDiffPng;
     }
-    if (v.effectsRan) {
-        if (!v.effects.lights.empty()) {
+    if (v.effects.ran()) {
+        if (!v.effects->lights.empty()) {
             Json shadows = Json::array();
-            for (size_t l = 0; l < v.effects.lights.size(); ++l) shadows.push_back(shadowImageName(names, l, v));
+            for (size_t l = 0; l < v.effects->lights.size(); ++l) shadows.push_back(shadowImageName(names, l, v));
             im["shadow_png"] = shadows;
         }
         im["secondary_png"] = names.secondaryPng;
@@ -460,26 +460,15 @@ Json viewJson(const ViewResult &v, const std::string &base, const std::vector<st
     vj["stages"] = stages;
     vj["zbuffer"] = json::write(v.zbuffer);
     const ViewImageNames names = viewImageNames(v.imageBase.empty() ? base : v.imageBase);
-    if (v.raycastRan)
-        vj["raycast"] = raycastJson(v, lightNames);
-    else
-        vj["raycast"] = {{"ran", false}, {"reason", "turned off by --no-raycast"}};
-    if (v.orderingRan)
-        vj["ordering"] = orderingJson(v.ordering);
-    else
-        vj["ordering"] = {{"ran", false}, {"reason", v.orderingReason}};
-    if (v.detailRan)
-        vj["detail"] = json::write(v.detail);
-    else
-        vj["detail"] = {{"ran", false}, {"reason", "turned off by --no-detail"}};
-    if (v.auditRan)
-        vj["audit"] = auditJson(v);
-    else
-        vj["audit"] = {{"ran", false}, {"reason", v.auditReason}};
-    if (v.zfightRan)
-        vj["depth"] = depthJson(v.zfight, v.zfightMs);
-    else
-        vj["depth"] = {{"ran", false}, {"reason", v.zfightReason}};
+    // A section that ran is written whole; one that did not says why.
+    auto section = [](const auto &ran, auto write) {
+        return ran.ran() ? write(*ran) : Json{{"ran", false}, {"reason", ran.reason()}};
+    };
+    vj["raycast"] = section(v.raycast, [&](const RaycastResult &) { return raycastJson(v, lightNames); });
+    vj["ordering"] = section(v.ordering, orderingJson);
+    vj["detail"] = section(v.detail, [](const DetailResult &d) { return json::write(d); });
+    vj["audit"] = section(v.audit, [&](const CullingAuditResult &) { return auditJson(v); });
+    vj["depth"] = section(v.zfight, depthJson);
     vj["images"] = viewImagesJson(v, names, images);
     vj["depth_curve"] = v.depthCurve >= 0 ? Json(uint64_t(v.depthCurve)) : Json(nullptr);
     vj["total_ms"] = num(v.totalMs);

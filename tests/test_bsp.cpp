@@ -448,12 +448,12 @@ TEST(Audit, TinyMapPvsEvidence) {
     AnalysisResult out;
     ASSERT_TRUE(analyzeScene(s, {v}, ps, nullptr, &out, &err)) << err;
     const ViewResult &r = out.views[0];
-    const PvsEvidence &e = r.pvsEvidence;
+    const PvsEvidence &e = r.audit->pvsEvidence;
     ASSERT_TRUE(e.ran);
     EXPECT_EQ(e.cameraLeaf, 0);
     EXPECT_EQ(e.cameraCluster, 0);
     EXPECT_EQ(e.designFarPlane, 0);
-    const StageCullAudit &cells = r.cullAudit.stages[0];
+    const StageCullAudit &cells = r.audit->cull.stages[0];
     ASSERT_EQ(cells.stage, "cells");
     EXPECT_EQ(e.falseCullPixels, cells.falseCullPixels);
     EXPECT_EQ(e.falseCullObjects, cells.falseCullObjects);
@@ -511,12 +511,12 @@ TEST(Audit, TinyMapPvsEvidence) {
     for (const PvsObjectEvidence &o : e.objects)
         for (const PvsFaceEvidence &f : o.faces) {
             const size_t i = size_t(f.y) * 160 + size_t(f.x);
-            ASSERT_GT(r.reference.id[i], 0u);
-            const uint32_t t = r.reference.id[i] - 1;
+            ASSERT_GT(r.audit->reference.id[i], 0u);
+            const uint32_t t = r.audit->reference.id[i] - 1;
             EXPECT_EQ(s.bsp->triangleFace[t], f.face);
             EXPECT_EQ(s.triangleObject[t], o.object);
-            EXPECT_EQ(r.cullAudit.fate[i], kFateCulledFirst);
-            EXPECT_EQ(pixelPointDistance(r.camera, i, r.reference.depth[i]), f.nearest);
+            EXPECT_EQ(r.audit->cull.fate[i], kFateCulledFirst);
+            EXPECT_EQ(pixelPointDistance(r.camera, i, r.audit->reference.depth[i]), f.nearest);
         }
 }
 
@@ -1365,9 +1365,9 @@ TEST(Audit, RealMapsBrushEntitiesLeaveNoFalseCulls) {
         ASSERT_TRUE(analyzeScene(s, s.views, ps, nullptr, &out, &err)) << err;
         uint64_t falsePixels = 0, cellsCulled = 0, genuine = 0;
         for (const ViewResult &v : out.views) {
-            falsePixels += v.cullAudit.falseCullPixels;
+            falsePixels += v.audit->cull.falseCullPixels;
             cellsCulled += v.cells.objectsCulled;
-            genuine += v.crossCheck.genuine;
+            genuine += v.raycast->crossCheck.genuine;
         }
         std::printf("  %s: %zu views, PVS culled %llu objects, false-cull pixels %llu, genuine %llu\n", path,
                     out.views.size(), (unsigned long long)cellsCulled, (unsigned long long)falsePixels,
@@ -1449,9 +1449,9 @@ TEST(Audit, RealMapsFarPlaneHiddenByDesign) {
         ASSERT_TRUE(analyzeScene(s, views, ps, nullptr, &out, &err)) << err;
         uint64_t genuine = 0, culled = 0, beyond = 0, falsePx = 0;
         for (const ViewResult &v : out.views) {
-            genuine += v.crossCheck.genuine, culled += v.crossCheck.culled;
-            beyond += v.cullAudit.beyondFarPlanePixels, falsePx += v.cullAudit.falseCullPixels;
-            EXPECT_EQ(v.crossCheck.recast, v.crossCheck.culled > 0);
+            genuine += v.raycast->crossCheck.genuine, culled += v.raycast->crossCheck.culled;
+            beyond += v.audit->cull.beyondFarPlanePixels, falsePx += v.audit->cull.falseCullPixels;
+            EXPECT_EQ(v.raycast->crossCheck.recast, v.raycast->crossCheck.culled > 0);
         }
         EXPECT_EQ(genuine, 0u) << w.path;
         EXPECT_EQ(falsePx, 0u) << w.path;
@@ -1538,13 +1538,13 @@ TEST(Audit, RealMapEvidenceAgreesWithTheFile) {
     ASSERT_TRUE(analyzeScene(s, views, ps, nullptr, &out, &err)) << err;
     uint64_t faces = 0, leafs = 0, bits = 0, falsePixels = 0;
     for (const ViewResult &r : out.views) {
-        const PvsEvidence &e = r.pvsEvidence;
+        const PvsEvidence &e = r.audit->pvsEvidence;
         ASSERT_TRUE(e.ran);
-        falsePixels += r.cullAudit.falseCullPixels;
+        falsePixels += r.audit->cull.falseCullPixels;
         // The camera: its leaf by the file's tree, its cluster by the file's leafs.
         EXPECT_EQ(e.cameraLeaf, raw.leafAt(r.camera.eye)) << r.spec.name;
         EXPECT_EQ(e.cameraCluster, raw.leafCluster(e.cameraLeaf)) << r.spec.name;
-        EXPECT_EQ(e.falseCullPixels, r.cullAudit.falseCullPixels);  // every false cull is the PVS's
+        EXPECT_EQ(e.falseCullPixels, r.audit->cull.falseCullPixels);  // every false cull is the PVS's
         EXPECT_EQ(e.objectsOmitted, 0u);
         ASSERT_FALSE(e.objects.empty()) << r.spec.name;
         for (const PvsObjectEvidence &o : e.objects) {
@@ -1577,10 +1577,10 @@ TEST(Audit, RealMapEvidenceAgreesWithTheFile) {
                 }
                 // The face is seen at its pixel, culled falsely, no farther than the map allows.
                 const size_t i = size_t(f.y) * size_t(r.camera.width) + size_t(f.x);
-                ASSERT_GT(r.reference.id[i], 0u);
-                EXPECT_EQ(s.bsp->triangleFace[r.reference.id[i] - 1], f.face);
-                EXPECT_EQ(r.cullAudit.fate[i], kFateCulledFirst);
-                EXPECT_EQ(pixelPointDistance(r.camera, i, r.reference.depth[i]), f.nearest);
+                ASSERT_GT(r.audit->reference.id[i], 0u);
+                EXPECT_EQ(s.bsp->triangleFace[r.audit->reference.id[i] - 1], f.face);
+                EXPECT_EQ(r.audit->cull.fate[i], kFateCulledFirst);
+                EXPECT_EQ(pixelPointDistance(r.camera, i, r.audit->reference.depth[i]), f.nearest);
             }
         }
         std::printf("  %s: camera leaf %d cluster %d; %zu object(s), first %s face %u at %.1f units\n",

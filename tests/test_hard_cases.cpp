@@ -185,11 +185,11 @@ TEST(HardCases, SliversBelowOneMicroradianCoverExactlyByTheFillRule) {
     for (int x = 0; x < 64; ++x) EXPECT_EQ(r.buffer.id[31 * 64 + x], 1u) << "x " << x;  // t0 on row 31
     EXPECT_EQ(pixelsWithId(r.buffer.id, 1), 64u);
     // The reference visibility walks the same fragment core: the same 64 pixels.
-    EXPECT_EQ(r.reference.coveredPixels, 64u);
-    EXPECT_EQ(r.reference.id, r.buffer.id);
+    EXPECT_EQ(r.audit->reference.coveredPixels, 64u);
+    EXPECT_EQ(r.audit->reference.id, r.buffer.id);
 
-    ASSERT_TRUE(r.raycastRan);
-    const CrossCheck &c = r.crossCheck;
+    ASSERT_TRUE(r.raycast.ran());
+    const CrossCheck &c = r.raycast->crossCheck;
     EXPECT_EQ(c.genuine, 0u);
     EXPECT_EQ(c.tie, 0u);
     EXPECT_EQ(c.agree + c.edge, 64u * 64u);
@@ -252,7 +252,7 @@ TEST(HardCases, TriangleOnASidePlaneIsEdgeOn) {
     EXPECT_EQ(nb.clip.edgeOn, 1u);
     EXPECT_EQ(nb.clip.trianglesOut, 0u);
     EXPECT_EQ(nb.zbuffer.fragments, 0u);
-    EXPECT_EQ(nb.reference.coveredPixels, 0u);
+    EXPECT_EQ(nb.audit->reference.coveredPixels, 0u);
 }
 
 // Hard: two vertices on the near plane and one behind it: Sutherland-Hodgman computes both
@@ -316,14 +316,14 @@ TEST(HardCases, EyeOnTheTrianglePlaneNeedsTheExactPredicate) {
     const ViewResult r = run(scene, view);
     EXPECT_EQ(r.backface.edgeOn, 1u);
     EXPECT_EQ(r.zbuffer.fragments, 0u);
-    EXPECT_EQ(r.reference.coveredPixels, 0u);
-    EXPECT_EQ(r.cullAudit.falseCullTriangles, 0u);
-    EXPECT_EQ(r.crossCheck.genuine, 0u);
+    EXPECT_EQ(r.audit->reference.coveredPixels, 0u);
+    EXPECT_EQ(r.audit->cull.falseCullTriangles, 0u);
+    EXPECT_EQ(r.raycast->crossCheck.genuine, 0u);
     const ViewResult nb = run(scene, view, withoutBackface());
     EXPECT_EQ(nb.clip.edgeOn + nb.clip.trianglesOut, 1u);
     EXPECT_EQ(nb.zbuffer.trianglesEmpty, nb.clip.trianglesOut);
     EXPECT_EQ(nb.zbuffer.fragments, 0u);
-    EXPECT_EQ(nb.crossCheck.genuine, 0u);
+    EXPECT_EQ(nb.raycast->crossCheck.genuine, 0u);
 }
 
 // ---- near = 1e-6, far = 1e9 -------------------------------------------------------------------
@@ -450,12 +450,12 @@ TEST(HardCases, SceneTenMillionUnitsAwayMatchesTheSceneAtTheOrigin) {
     for (size_t i = 0; i < a.buffer.depth.size(); ++i)
         if (a.buffer.id[i]) worst = std::max(worst, std::fabs(a.buffer.depth[i] - b.buffer.depth[i]) / a.buffer.depth[i]);
     EXPECT_LE(worst, 1e-8);
-    EXPECT_TRUE(a.reference.id == b.reference.id) << "reference id images differ";
-    EXPECT_TRUE(a.raycastImage.id == b.raycastImage.id) << "raycast id images differ";
-    EXPECT_EQ(a.crossCheck.genuine, 0u);
-    EXPECT_EQ(b.crossCheck.genuine, 0u);
-    EXPECT_EQ(a.cullAudit.falseCullTriangles, b.cullAudit.falseCullTriangles);
-    EXPECT_EQ(b.cullAudit.falseCullTriangles, 0u);
+    EXPECT_TRUE(a.audit->reference.id == b.audit->reference.id) << "reference id images differ";
+    EXPECT_TRUE(a.raycast->image.id == b.raycast->image.id) << "raycast id images differ";
+    EXPECT_EQ(a.raycast->crossCheck.genuine, 0u);
+    EXPECT_EQ(b.raycast->crossCheck.genuine, 0u);
+    EXPECT_EQ(a.audit->cull.falseCullTriangles, b.audit->cull.falseCullTriangles);
+    EXPECT_EQ(b.audit->cull.falseCullTriangles, 0u);
 }
 
 // ---- A triangle whose projection spans 1e9 pixels ----------------------------------------------
@@ -484,7 +484,7 @@ TEST(HardCases, BillionPixelTriangleIsClippedToTheGuardBand) {
         EXPECT_EQ(r.zbuffer.maxDepthComplexity, 1u);
         for (int y = 0; y < 64; ++y)
             for (int x = 0; x < 64; ++x) ASSERT_EQ(r.buffer.id[y * 64 + x], y >= 32 ? 1u : 0u) << x << "," << y;
-        EXPECT_EQ(r.crossCheck.genuine, 0u);
+        EXPECT_EQ(r.raycast->crossCheck.genuine, 0u);
     }
     {
         const Scene scene = looseTriangles({{Vec3{-1e8, -1e8, -1}, Vec3{1e8, -1e8, -1}, Vec3{0, 1e8, -1}}});
@@ -493,7 +493,7 @@ TEST(HardCases, BillionPixelTriangleIsClippedToTheGuardBand) {
         EXPECT_EQ(r.zbuffer.fragments, 4096u);
         EXPECT_EQ(r.zbuffer.coveredPixels, 4096u);
         EXPECT_EQ(r.zbuffer.maxDepthComplexity, 1u);
-        EXPECT_EQ(r.crossCheck.genuine, 0u);
+        EXPECT_EQ(r.raycast->crossCheck.genuine, 0u);
     }
 }
 
@@ -737,7 +737,7 @@ TEST_F(HardInput, MeshWithZeroTrianglesGivesAReportWithZeroCounts) {
         EXPECT_EQ(v.zbuffer.coveredPixels, 0u);
         EXPECT_EQ(v.zbuffer.overdraw, 0.0);
         EXPECT_EQ(v.zbuffer.depthComplexity, 0.0);
-        EXPECT_EQ(v.crossCheck.agree, v.crossCheck.pixels);
+        EXPECT_EQ(v.raycast->crossCheck.agree, v.raycast->crossCheck.pixels);
     }
     const fs::path outDir = dir_ / "out";
     const Run r = program("analyze " + p + " --views orbit:2 --width 32 --height 24 --out " + outDir.string());

@@ -279,7 +279,7 @@ TEST(Limits, RecursionDepth) {
                    "may trace 2^21 - 2 secondary rays); lower --max-depth or raise the limit with --max-recursion 20");
     s.limits.maxRecursion = 20;
     ASSERT_TRUE(analyzeScene(scene, {v}, s, nullptr, &result, &err)) << err;
-    EXPECT_TRUE(result.views[0].effectsRan);
+    EXPECT_TRUE(result.views[0].effects.ran());
 
     // Without a refractive or reflective material no secondary ray is traced: no limit applies.
     const Scene plain = testing_util::sceneOf({testing_util::triangleMesh({-1, -1, 0}, {1, -1, 0}, {0, 1, 0})});
@@ -347,8 +347,8 @@ TEST(Limits, ABufferLimitStopsTheRun) {
         << err;
     s.limits.maxABufferList = 3;
     ASSERT_TRUE(analyzeScene(scene, {v}, s, nullptr, &result, &err)) << err;
-    ASSERT_TRUE(result.views[0].ordering.abufferRan);
-    EXPECT_EQ(result.views[0].ordering.abuffer.maxListLength, 3u);
+    ASSERT_TRUE(result.views[0].ordering->abufferRan);
+    EXPECT_EQ(result.views[0].ordering->abuffer.maxListLength, 3u);
 }
 
 }  // namespace

@@ -203,6 +203,16 @@ struct OrderingResult {
     std::string abufferReason;                   // the planner's reason (run or skipped)
     ABufferResult abuffer;
     double ms = 0;
+    // Frees the per-pixel buffers once the images are written (the statistics stay).
+    void releasePixels() {
+        std::vector<uint32_t>().swap(painter.id);
+        std::vector<uint8_t>().swap(painter.cls);
+        std::vector<uint32_t>().swap(bsp.id);
+        std::vector<uint8_t>().swap(bsp.cls);
+        std::vector<uint32_t>().swap(scanline.id);
+        std::vector<uint8_t>().swap(abuffer.rgb);
+        std::vector<uint8_t>().swap(abuffer.edge);
+    }
 };
 
 // Everything for one view. `tree` is the scene's BSP tree (built once: buildBspTree); `abuffer`

@@ -166,6 +166,13 @@ struct ZFightResult {
     std::vector<uint8_t> pixelClass;     // ZPixelClass
     std::vector<uint32_t> fightMask;     // bit i: fights in formats[i]
     std::vector<uint32_t> hotspotOf;     // hotspot id (1-based, also beyond the listed ones); 0 = none
+    double ms = 0;                       // wall time of the analysis (the pipeline's clock)
+    // Frees the per-pixel buffers once the images are written (the statistics and hotspots stay).
+    void releasePixels() {
+        std::vector<uint8_t>().swap(pixelClass);
+        std::vector<uint32_t>().swap(fightMask);
+        std::vector<uint32_t>().swap(hotspotOf);
+    }
 };
 
 // The analysis. `tris` are the triangles the z-buffer draws for this view (clip stage output);
