@@ -25,25 +25,6 @@ uint64_t trianglesOf(const Scene &scene, const std::vector<uint32_t> &objects) {
     return n;
 }
 
-StageRecord skipped(const char *name, const std::string &reason) {
-    StageRecord r;
-    r.name = name;
-    r.ran = false;
-    r.reason = reason;
-    return r;
-}
-
-StageRecord ran(const char *name, uint64_t in, uint64_t culled, uint64_t out, double ms) {
-    StageRecord r;
-    r.name = name;
-    r.ran = true;
-    r.trianglesIn = in;
-    r.trianglesCulled = culled;
-    r.trianglesOut = out;
-    r.ms = ms;
-    return r;
-}
-
 // The objects of `before` missing from `after` (both ascending).
 std::vector<uint32_t> removed(const std::vector<uint32_t> &before, const std::vector<uint32_t> &after) {
     std::vector<uint32_t> out;
@@ -74,7 +55,7 @@ constexpr const ObjectStage *kObjectStages[] = {
 void runObjectStage(ViewContext &c, const ObjectStage &stage, std::vector<uint32_t> &objects) {
     const std::string why = stage.skip(c);
     if (!why.empty()) {
-        c.r.stages.push_back(skipped(stage.name, why));
+        c.r.stages.push_back(skippedStage(stage.name, why));
         return;
     }
     const uint64_t in = trianglesOf(c.scene, objects);
@@ -90,14 +71,14 @@ void runObjectStage(ViewContext &c, const ObjectStage &stage, std::vector<uint32
     }
     objects = std::move(out.kept);
     const uint64_t kept = trianglesOf(c.scene, objects);
-    c.r.stages.push_back(ran(stage.name, in, in - kept, kept, ms));
+    c.r.stages.push_back(ranStage(stage.name, in, in - kept, kept, ms));
 }
 
 // ---- Triangle stages ----------------------------------------------------------------------------
 // Backface: plane at the eye, per triangle. Returns the triangles kept, per object.
 TriangleLists runBackface(ViewContext &c, const std::vector<uint32_t> &objects) {
     if (!c.s.backface) {
-        c.r.stages.push_back(skipped("backface", "turned off by --no-backface"));
+        c.r.stages.push_back(skippedStage("backface", "turned off by --no-backface"));
         return allTriangles(c.scene, objects);
     }
     const Stopwatch t0;
@@ -106,7 +87,7 @@ TriangleLists runBackface(ViewContext &c, const std::vector<uint32_t> &objects) 
     c.r.backface = b.stats;
     if (c.s.audit) c.culls.push_back({"backface", {}, std::move(b.culled), true});
     const uint64_t in = trianglesOf(c.scene, objects), out = b.kept.size();
-    c.r.stages.push_back(ran("backface", in, in - out, out, ms));
+    c.r.stages.push_back(ranStage("backface", in, in - out, out, ms));
     return std::move(b.kept);
 }
 
@@ -119,7 +100,7 @@ ClipResult runClip(ViewContext &c, const TriangleLists &lists) {
     c.r.clip = clip.stats;
     const ClipStats &cs = clip.stats;
     // Out: screen triangles, after fan triangulation.
-    c.r.stages.push_back(ran("clip", lists.size(), cs.trivialRejected + cs.clippedAway + cs.edgeOn, cs.trianglesOut, ms));
+    c.r.stages.push_back(ranStage("clip", lists.size(), cs.trivialRejected + cs.clippedAway + cs.edgeOn, cs.trianglesOut, ms));
     return clip;
 }
 
@@ -139,7 +120,7 @@ std::vector<uint32_t> runZBuffer(ViewContext &c, const ClipResult &clip) {
     const double ms = t0.ms();
     c.r.zbuffer = z.stats;
     c.r.buffer = std::move(z.buffer);
-    c.r.stages.push_back(ran("zbuffer", z.stats.trianglesIn, z.stats.trianglesEmpty, z.stats.trianglesDrawn, ms));
+    c.r.stages.push_back(ranStage("zbuffer", z.stats.trianglesIn, z.stats.trianglesEmpty, z.stats.trianglesDrawn, ms));
     return fragmentsPerSource;
 }
 
@@ -151,7 +132,7 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     const Scene &scene = c.scene;
     ViewResult &r = c.r;
     if (!ps.rays) {
-        r.stages.push_back(skipped("raycast", "turned off by --no-raycast"));
+        r.stages.push_back(skippedStage("raycast", "turned off by --no-raycast"));
         r.raycast.skip("turned off by --no-raycast");
         return;
     }
@@ -188,7 +169,7 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
         sameSet = ps.rays->castPrimary(c.cam, same, nullptr);
     }
     // Triangles no ray hit: "culled" in the sense of this stage's funnel (not visible).
-    r.stages.push_back(ran("raycast", in, in - hit, hit, t0.ms()));
+    r.stages.push_back(ranStage("raycast", in, in - hit, hit, t0.ms()));
     const RaycastImage &compared = culledPixels > 0 ? sameSet : ray.image;
     ray.crossCheck = crossCheck(r.buffer.id, r.buffer.depth, compared.id, compared.depth, scene, c.cam,
                               makeDepthEncoder(c.view.depthFormat, c.cam.nearZ, c.cam.farZ), ps.rays->origin());

@@ -38,6 +38,11 @@ struct StageRecord {
     uint64_t trianglesOut = 0; // triangles leaving it (clip: screen triangles after fan triangulation)
     double ms = 0;             // wall time of the stage for this view
 };
+// A funnel row of a stage that ran, and of one that did not (and why).
+inline StageRecord ranStage(const char *name, uint64_t in, uint64_t culled, uint64_t out, double ms) {
+    return {name, true, {}, in, culled, out, ms};
+}
+inline StageRecord skippedStage(const char *name, std::string reason) { return {name, false, std::move(reason), 0, 0, 0, 0}; }
 
 struct FrustumStats {
     uint64_t objectsIn = 0;           // culling objects entering the stage

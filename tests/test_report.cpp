@@ -154,22 +154,8 @@ Json loadSchema() {
 
 // ---- A synthetic analysis result -------------------------------------------------------------
 
-StageRecord stage(const char *name, uint64_t in, uint64_t culled, uint64_t out, double ms) {
-    StageRecord s;
-    s.name = name;
-    s.ran = true;
-    s.trianglesIn = in;
-    s.trianglesCulled = culled;
-    s.trianglesOut = out;
-    s.ms = ms;
-    return s;
-}
-StageRecord skipped(const char *name, const char *reason) {
-    StageRecord s;
-    s.name = name;
-    s.reason = reason;
-    return s;
-}
+constexpr auto stage = ranStage;
+constexpr auto skipped = skippedStage;
 
 ViewResult spawnView() {
     ViewResult v;
