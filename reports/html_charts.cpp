@@ -113,7 +113,8 @@ std::string scatterSvg(const std::vector<ScatterPoint> &pts, const std::string &
 // `visaudit depth-audit`); the view's own format drawn thick, dashed markers at the hotspots'
 // depths. Colors are depthPlotColor's (the same as depth-audit.png).
 std::string resolutionSvg(const Json *curve, const std::string &ownFormat,
-                          const std::vector<std::pair<std::string, double>> &markers, const std::string &id) {
+                          const std::vector<std::pair<std::string, double>> &markers, const std::string &id,
+                          const std::string &sharedId, bool defineShared) {
     // The curve set as the report stores it: depths, and per format its resolution at each depth
     // (null where the format does not represent the depth).
     const Json *depthsJson = get(curve, "depths"), *formats = get(curve, "formats");
@@ -150,32 +151,10 @@ std::string resolutionSvg(const Json *curve, const std::string &ownFormat,
     std::string o = "<svg class=\"chart resolution lightpanel\" id=\"" + id +
                     "\" viewBox=\"0 0 860 340\" role=\"img\" aria-label=\"Depth resolution against view depth per format\">"
                     "<rect class=\"panel\" x=\"0\" y=\"0\" width=\"860\" height=\"340\" rx=\"6\"/>";
-    // Decade grid lines (both axes).
-    for (double e = std::ceil(xLo); e <= std::floor(xHi); e += 1)
-        o += "<line class=\"grid\" x1=\"" + fx(X(std::pow(10, e))) + "\" y1=\"" + fx(T) + "\" x2=\"" + fx(X(std::pow(10, e))) +
-             "\" y2=\"" + fx(B) + "\"/><text class=\"muted\" text-anchor=\"middle\" x=\"" + fx(X(std::pow(10, e))) +
-             "\" y=\"" + fx(B + 15) + "\">1e" + std::to_string(int(e)) + "</text>";
-    const int yStep = std::max(1, int((dHi - dLo) / 8));
-    for (double e = dLo; e <= dHi; e += yStep)
-        o += "<line class=\"grid\" x1=\"" + fx(L) + "\" y1=\"" + fx(Y(std::pow(10, e))) + "\" x2=\"" + fx(R) + "\" y2=\"" +
-             fx(Y(std::pow(10, e))) + "\"/><text class=\"muted\" text-anchor=\"end\" x=\"" + fx(L - 5) + "\" y=\"" +
-             fx(Y(std::pow(10, e)) + 4) + "\">1e" + std::to_string(int(e)) + "</text>";
-    o += "<text text-anchor=\"middle\" x=\"" + fx((L + R) / 2) + "\" y=\"" + fx(B + 34) + "\">view depth (m), near " +
-         fmtReal(*nearZ) + " to far " + fmtReal(*farZ) + "</text>";
-    o += "<text text-anchor=\"middle\" transform=\"translate(14 " + fx((T + B) / 2) + ") rotate(-90)\">resolution (m)</text>";
-    for (const auto &[name, depth] : markers) {
-        if (!(depth >= *nearZ && depth <= *farZ)) continue;
-        o += "<line class=\"mark\" x1=\"" + fx(X(depth)) + "\" y1=\"" + fx(T) + "\" x2=\"" + fx(X(depth)) + "\" y2=\"" +
-             fx(B) + "\"><title>hotspot " + esc(name) + " at " + fmtReal(depth) + " m</title></line>";
-        o += "<text class=\"marklabel\" x=\"" + fx(X(depth) + 3) + "\" y=\"" + fx(T + 10) + "\">" + esc(name) + "</text>";
-    }
-    int legendRow = 0;
-    for (const Series &f : series) {
-        DepthFormatSpec spec;
-        const Rgb8 c = parseDepthFormat(f.name, &spec, nullptr) ? depthPlotColor(spec) : Rgb8{128, 128, 128};
-        char color[16];
-        std::snprintf(color, sizeof color, "#%02x%02x%02x", c.r, c.g, c.b);
-        const bool own = f.name == ownFormat;
+    // What every view of this curve set shares -- the decade grid (both axes), the axis titles and
+    // every format's curve -- is drawn once, in the first view that uses the set, and referenced by
+    // the others (<use>): a report of hundreds of views of one near/far carries the curves once.
+    auto curvePath = [&](const Series &f) {
         std::string d;  // one path, broken ("M") where a sample is absent
         bool pen = false;
         for (size_t i = 0; i < depths.size() && i < f.resolution.size(); ++i) {
@@ -187,8 +166,50 @@ std::string resolutionSvg(const Json *curve, const std::string &ownFormat,
             d += (pen ? "L" : "M") + fx(X(depths[i])) + " " + fx(Y(*v));
             pen = true;
         }
-        o += "<path fill=\"none\" stroke=\"" + std::string(color) + "\" stroke-width=\"" + (own ? "3.5" : "1.5") + "\" d=\"" +
-             d + "\"><title>" + esc(f.name) + (own ? " (this view's format)" : "") + "</title></path>";
+        return d;
+    };
+    auto colorOf = [](const Series &f) {
+        DepthFormatSpec spec;
+        const Rgb8 c = parseDepthFormat(f.name, &spec, nullptr) ? depthPlotColor(spec) : Rgb8{128, 128, 128};
+        char color[16];
+        std::snprintf(color, sizeof color, "#%02x%02x%02x", c.r, c.g, c.b);
+        return std::string(color);
+    };
+    if (defineShared) {
+        o += "<g id=\"" + sharedId + "\">";
+        for (double e = std::ceil(xLo); e <= std::floor(xHi); e += 1)
+            o += "<line class=\"grid\" x1=\"" + fx(X(std::pow(10, e))) + "\" y1=\"" + fx(T) + "\" x2=\"" + fx(X(std::pow(10, e))) +
+                 "\" y2=\"" + fx(B) + "\"/><text class=\"muted\" text-anchor=\"middle\" x=\"" + fx(X(std::pow(10, e))) +
+                 "\" y=\"" + fx(B + 15) + "\">1e" + std::to_string(int(e)) + "</text>";
+        const int yStep = std::max(1, int((dHi - dLo) / 8));
+        for (double e = dLo; e <= dHi; e += yStep)
+            o += "<line class=\"grid\" x1=\"" + fx(L) + "\" y1=\"" + fx(Y(std::pow(10, e))) + "\" x2=\"" + fx(R) + "\" y2=\"" +
+                 fx(Y(std::pow(10, e))) + "\"/><text class=\"muted\" text-anchor=\"end\" x=\"" + fx(L - 5) + "\" y=\"" +
+                 fx(Y(std::pow(10, e)) + 4) + "\">1e" + std::to_string(int(e)) + "</text>";
+        o += "<text text-anchor=\"middle\" x=\"" + fx((L + R) / 2) + "\" y=\"" + fx(B + 34) + "\">view depth (m), near " +
+             fmtReal(*nearZ) + " to far " + fmtReal(*farZ) + "</text>";
+        o += "<text text-anchor=\"middle\" transform=\"translate(14 " + fx((T + B) / 2) + ") rotate(-90)\">resolution (m)</text>";
+        for (const Series &f : series)
+            o += "<path fill=\"none\" stroke=\"" + colorOf(f) + "\" stroke-width=\"1.5\" d=\"" + curvePath(f) + "\"><title>" +
+                 esc(f.name) + "</title></path>";
+        o += "</g>";
+    } else {
+        o += "<use href=\"#" + sharedId + "\"/>";
+    }
+    for (const auto &[name, depth] : markers) {
+        if (!(depth >= *nearZ && depth <= *farZ)) continue;
+        o += "<line class=\"mark\" x1=\"" + fx(X(depth)) + "\" y1=\"" + fx(T) + "\" x2=\"" + fx(X(depth)) + "\" y2=\"" +
+             fx(B) + "\"><title>hotspot " + esc(name) + " at " + fmtReal(depth) + " m</title></line>";
+        o += "<text class=\"marklabel\" x=\"" + fx(X(depth) + 3) + "\" y=\"" + fx(T + 10) + "\">" + esc(name) + "</text>";
+    }
+    // This view's own format drawn bold over its thin curve, and the legend with it marked.
+    int legendRow = 0;
+    for (const Series &f : series) {
+        const std::string color = colorOf(f);
+        const bool own = f.name == ownFormat;
+        if (own)
+            o += "<path fill=\"none\" stroke=\"" + color + "\" stroke-width=\"3.5\" d=\"" + curvePath(f) + "\"><title>" +
+                 esc(f.name) + " (this view's format)</title></path>";
         const double ly = T + 6 + 17 * legendRow++;
         o += "<rect x=\"660\" y=\"" + fx(ly) + "\" width=\"14\" height=\"" + (own ? "6" : "3") + "\" fill=\"" + color + "\"/>";
         o += "<text x=\"680\" y=\"" + fx(ly + 6) + "\"" + (own ? " font-weight=\"bold\"" : "") + ">" + esc(f.name) +

@@ -12,6 +12,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -89,9 +90,12 @@ struct ScatterPoint {
 std::string scatterSvg(const std::vector<ScatterPoint> &pts, const std::string &id, const std::string &xTitle,
                        const std::string &yTitle);
 // Depth resolution against view depth, every format of a report's depth curve set
-// (report.depth_curves[k]), `ownFormat` drawn bold; markers are labelled depths (hotspots).
+// (report.depth_curves[k]), `ownFormat` drawn bold; markers are labelled depths (hotspots). The
+// grid and the curves are the set's, shared by every view of it: defined (id sharedId) when
+// defineShared, else referenced.
 std::string resolutionSvg(const Json *curve, const std::string &ownFormat,
-                          const std::vector<std::pair<std::string, double>> &markers, const std::string &id);
+                          const std::vector<std::pair<std::string, double>> &markers, const std::string &id,
+                          const std::string &sharedId, bool defineShared);
 
 // ---- The page (html.cpp, html_view.cpp) ------------------------------------------------------------
 
@@ -107,6 +111,7 @@ struct HtmlWriter {
     Folder folder;
     std::vector<const Json *> views = viewsOf(report);
     std::vector<size_t> worstFirst = worstFirstOf(report, views.size());
+    std::set<size_t> curvesDrawn;  // depth_curves sets already drawn (later views reference them)
     std::string o;
 
     void header();

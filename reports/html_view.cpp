@@ -403,7 +403,9 @@ void HtmlWriter::depthFormats(const Json *v, const std::string &id) {
     if (const Json *hs = get(d, "hotspots"); hs && hs->is_array())
         for (const Json &h : *hs)
             if (auto dep = num(get(&h, "depth")); dep && markers.size() < 12) markers.emplace_back("#" + fmtValue(get(&h, "id")), *dep);
-    const std::string svg = resolutionSvg(curve, own, markers, id + "-resolution");
+    const size_t set = size_t(*k);
+    const std::string svg = resolutionSvg(curve, own, markers, id + "-resolution", "depth-curves-" + std::to_string(set),
+                                          curvesDrawn.insert(set).second);
     if (svg.empty()) return;
     o += "<p class=\"note\">Depth resolution (the distance between two adjacent stored values) against view depth for "
          "this view's near and far planes, every format; lower is finer. Dashed lines: the hotspots' depths.</p>" + svg;

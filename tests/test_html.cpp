@@ -398,3 +398,36 @@ TEST(Findings, AnswersArePlainTextThePagePresents) {
                         "--no-detail); 10 triangles of 100"),
               std::string::npos);
 }
+
+// Views of one near/far share the resolution plot's grid and curves: drawn once, in the first view
+// that uses the set, and referenced (<use>) by the others, each with its own format drawn bold.
+TEST(Html, DepthCurvesAreDrawnOncePerSet) {
+    Json a = makeView("a", 0, 0, 0, 1.0), b = makeView("b", 0, 0, 0, 1.0), c = makeView("c", 0, 0, 0, 1.0);
+    a["depth_curve"] = 0, b["depth_curve"] = 0, c["depth_curve"] = nullptr;
+    b["depth_format"] = "unorm24";
+    Json r = makeReport({a, b, c});
+    r["depth_curves"] = Json::array({{{"near", 0.1},
+                                      {"far", 100.0},
+                                      {"depths", {0.2, 2.0, 20.0}},
+                                      {"formats",
+                                       {{{"name", "f32"}, {"resolution", {1e-7, 1e-5, nullptr}}},
+                                        {{"name", "unorm24"}, {"resolution", {1e-6, 1e-4, 1e-2}}}}}}});
+    const std::string html = va::reportHtml(r, "");
+    auto count = [&](const std::string &s) {
+        size_t n = 0;
+        for (size_t p = html.find(s); p != std::string::npos; p = html.find(s, p + 1)) ++n;
+        return n;
+    };
+    EXPECT_EQ(count("<g id=\"depth-curves-0\">"), 1u);
+    EXPECT_EQ(count("<use href=\"#depth-curves-0\"/>"), 1u);
+    EXPECT_EQ(count("id=\"v2-resolution\""), 0u);  // no curve set: no plot
+    // Each view's own format is drawn bold over the shared curves, and marked in its legend.
+    const size_t va = html.find("id=\"v0-resolution\""), vb = html.find("id=\"v1-resolution\"");
+    ASSERT_NE(va, std::string::npos);
+    ASSERT_NE(vb, std::string::npos);
+    EXPECT_NE(html.find("<title>f32 (this view's format)</title>", va), std::string::npos);
+    EXPECT_LT(html.find("<title>f32 (this view's format)</title>", va), vb);
+    EXPECT_NE(html.find("<title>unorm24 (this view's format)</title>", vb), std::string::npos);
+    // f32's curve breaks where it has no value: one segment, M then L.
+    EXPECT_EQ(count("stroke-width=\"1.5\" d=\"M"), 2u);
+}
