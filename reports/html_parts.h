@@ -107,6 +107,7 @@ constexpr size_t kEagerViews = 8;
 inline std::string viewId(size_t pos) { return "v" + std::to_string(pos); }
 
 struct HtmlWriter {
+    HtmlWriter(const Json &r, Folder f) : report(r), folder(std::move(f)) {}
     const Json &report;
     Folder folder;
     std::vector<const Json *> views = viewsOf(report);

@@ -9,6 +9,7 @@
 #include "tests/test_util.h"
 #include "analysis/stages/frustum.h"
 #include "analysis/pipeline.h"
+#include "render/camera.h"
 
 using namespace va;
 using namespace va::testing_util;
@@ -57,6 +58,64 @@ TEST(Backface, CubeFromGenericEyeCullsExactlySixOfTwelve) {
     const ViewResult r = run(scene, viewOf({1, 1, 5}, {0, 0, 0}));
     EXPECT_EQ(r.backface.trianglesCulled, 10u);
     EXPECT_EQ(r.backface.edgeOn, 4u);
+}
+
+// The stage's float filter (scene.cpp) only decides where the exact sign is certain: over random
+// triangles and eyes from 1e-6 to 1e7 in magnitude, with eyes on, next to and far from the planes,
+// the stage keeps exactly the triangles the exact per-triangle test (isFrontFacing) calls front, and
+// counts the same edge-on ones.
+TEST(Backface, FloatFilterAgreesWithTheExactTestOverWideMagnitudes) {
+    std::mt19937_64 rng(20261126);
+    std::uniform_real_distribution<double> unit(-1, 1), expo(-6, 7);
+    uint64_t decidedByFloat = 0, tested = 0;
+    for (int round = 0; round < 40; ++round) {
+        const double scale = std::pow(10.0, expo(rng));
+        RawMesh m;
+        const Vec3 offset{unit(rng) * scale * 10, unit(rng) * scale * 10, unit(rng) * scale * 10};
+        for (int t = 0; t < 300; ++t) {
+            for (int k = 0; k < 3; ++k)
+                m.positions.push_back(offset + Vec3{unit(rng) * scale, unit(rng) * scale, unit(rng) * scale});
+            m.indices.insert(m.indices.end(), {uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
+        }
+        const Scene scene = sceneOf({m});
+        ASSERT_EQ(scene.backfacePlanes.size(), scene.objectTriangles.size());
+        std::vector<uint32_t> objects(scene.objects.size());
+        for (size_t o = 0; o < objects.size(); ++o) objects[o] = uint32_t(o);
+        // Eyes: generic; on a triangle's plane (a vertex, the centroid); a hair off a vertex.
+        const Vec3 v0 = m.positions[0], v1 = m.positions[1], v2 = m.positions[2];
+        for (Vec3 eye : {offset + Vec3{unit(rng) * scale * 3, unit(rng) * scale * 3, unit(rng) * scale * 3}, v0,
+                         (v0 + v1 + v2) / 3.0, Vec3{std::nextafter(v1.x, 1e300), v1.y, v1.z},
+                         offset + Vec3{scale * 1e6, -scale * 1e6, scale * 1e6}}) {
+            CameraSpec spec;
+            spec.eye = eye;
+            spec.target = eye + Vec3{0, 0, -1};
+            spec.nearZ = 1e-3 * scale;
+            spec.farZ = 1e9 * scale;
+            Camera cam;
+            std::string err;
+            ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+            const BackfaceResult r = cullBackfaces(scene, objects, cam);
+            std::vector<uint32_t> kept;
+            uint64_t edgeOn = 0;
+            for (uint32_t o : objects)
+                for (uint32_t i = scene.objects[o].triBegin; i < scene.objects[o].triEnd; ++i) {
+                    const uint32_t t = scene.objectTriangles[i];
+                    bool on = false;
+                    if (isFrontFacing(scene, t, cam, &on)) kept.push_back(t);
+                    else edgeOn += on;
+                    const Scene::BackfacePlane &q = scene.backfacePlanes[i];
+                    const float M = float(maxAbs(eye)) * (1 + 0x1p-20f);
+                    const float sf = ((q.nx * float(eye.x) + q.ny * float(eye.y)) + q.nz * float(eye.z)) + q.k;
+                    decidedByFloat += std::fabs(sf) > q.a * M + q.b;
+                    ++tested;
+                }
+            EXPECT_EQ(r.kept.triangles, kept) << "scale " << scale << " eye " << eye.x << " " << eye.y << " " << eye.z;
+            EXPECT_EQ(r.stats.edgeOn, edgeOn);
+            EXPECT_EQ(r.stats.trianglesCulled + kept.size(), scene.objectTriangles.size());
+        }
+    }
+    // The filter decides nearly everything (else it would not pay for itself).
+    EXPECT_GT(double(decidedByFloat), 0.9 * double(tested));
 }
 
 TEST(Backface, DoubleSidedMaterialIsExempt) {

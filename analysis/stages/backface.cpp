@@ -1,6 +1,8 @@
 #include "analysis/stages/backface.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -90,39 +92,62 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
     l.objects.reserve(objects.size());
     uint64_t total = 0;
     for (uint32_t o : objects) total += scene.objects[o].triEnd - scene.objects[o].triBegin;
-    l.triangles.reserve(total);
     const double eyeMax = maxAbs(cam.eye);
+    // The float filter (scene.cpp, "The backface stage's float filter") decides a triangle from its
+    // plane in float, read in object order; what it cannot decide goes to the double filter and the
+    // exact test. Outputs are written branch-free into room for every triangle, then trimmed.
+    const bool floatFilter = !cam.orthographic && scene.backfacePlanes.size() == scene.objectTriangles.size();
+    const float ex = float(cam.eye.x), ey = float(cam.eye.y), ez = float(cam.eye.z);
+    const float M = [&] {
+        const float f = float(eyeMax);
+        return double(f) < eyeMax ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+    }();
+    l.triangles.resize(total);
+    r.culled.resize(total);
+    uint32_t *kept = l.triangles.data(), *culled = r.culled.data();
+    size_t nk = 0, nc = 0;
     for (uint32_t o : objects) {
         const SceneObject &ob = scene.objects[o];
-        const uint32_t begin = uint32_t(l.triangles.size());
+        const size_t begin = nk;
         const uint32_t n = ob.triEnd - ob.triBegin;
+        const uint32_t *tris = scene.objectTriangles.data();
         if (scene.materialOf(ob).doubleSided) {
             st.doubleSidedExempt += n;
-            l.triangles.insert(l.triangles.end(), scene.objectTriangles.begin() + ob.triBegin,
-                               scene.objectTriangles.begin() + ob.triEnd);
+            std::copy(tris + ob.triBegin, tris + ob.triEnd, kept + nk);
+            nk += n;
         } else {
             st.trianglesTested += n;
-            // isFrontFacing's filter with the eye's magnitude taken once; only where it cannot
-            // decide does the full test run.
-            const uint32_t *tris = scene.objectTriangles.data();
             for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) {
                 const uint32_t t = tris[i];
-                const int side = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
-                bool edgeOn = false;
-                if (side > 0 || (side == 0 && isFrontFacing(scene, t, cam, &edgeOn))) {
-                    l.triangles.push_back(t);
-                } else {
-                    r.culled.push_back(t);
-                    ++st.trianglesCulled;
-                    st.edgeOn += edgeOn;
+                int side = 0;
+                if (floatFilter) {
+                    const Scene::BackfacePlane &q = scene.backfacePlanes[i];
+                    const float sf = ((q.nx * ex + q.ny * ey) + q.nz * ez) + q.k;
+                    const float bound = q.a * M + q.b;
+                    side = sf > bound ? 1 : (sf < -bound ? -1 : 0);
                 }
+                bool edgeOn = false;
+                if (side == 0) {
+                    // isFrontFacing's double filter with the eye's magnitude taken once; only where it
+                    // cannot decide does the full test run.
+                    side = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
+                    if (side == 0) side = isFrontFacing(scene, t, cam, &edgeOn) ? 1 : -1;
+                }
+                kept[nk] = t;
+                culled[nc] = t;
+                nk += side > 0;
+                nc += side < 0;
+                st.edgeOn += edgeOn && side < 0;  // an edge-on triangle kept (orthographic) is not counted
             }
         }
-        if (l.triangles.size() > begin) {  // objects with every triangle culled leave no group
+        if (nk > begin) {  // objects with every triangle culled leave no group
             l.objects.push_back(o);
-            l.groupBegin.push_back(begin);
+            l.groupBegin.push_back(uint32_t(begin));
         }
     }
+    st.trianglesCulled = nc;
+    l.triangles.resize(nk);
+    r.culled.resize(nc);
     l.groupBegin.push_back(uint32_t(l.triangles.size()));
     return r;
 }
