@@ -371,7 +371,7 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     auto bytesOf = [](const auto &v) { return uint64_t(v.capacity()) * sizeof(v[0]); };
     const uint64_t tris = scene.triangleCount();
     m.scene = bytesOf(scene.positions) + bytesOf(scene.indices) + bytesOf(scene.triangleObject) +
-              bytesOf(scene.objectTriangles) + bytesOf(scene.planes) + bytesOf(scene.planeBounds) + bytesOf(scene.backfacePlanes) +
+              bytesOf(scene.objectTriangles) + bytesOf(scene.planes) + bytesOf(scene.planeBounds) + scene.backfacePlanes.bytes() +
               uint64_t(scene.objects.size()) * (sizeof(SceneObject) + 32) +
               uint64_t(scene.sources.size()) * (sizeof(SourceObject) + 64);
     if (scene.bsp) m.scene += bytesOf(scene.bsp->pvs) + bytesOf(scene.bsp->leafFaces) + bytesOf(scene.bsp->nodes) +

@@ -162,7 +162,7 @@ static void buildBackfacePlanes(Scene &s) {
         const uint32_t t = s.objectTriangles[i];
         const double *p = &s.planes[4 * size_t(t)];
         const double A = s.planeBounds[2 * size_t(t)], V = s.planeBounds[2 * size_t(t) + 1];
-        s.backfacePlanes[i] = backfacePlaneOf(p, A, V);
+        s.backfacePlanes.set(i, backfacePlaneOf(p, A, V));
     }
 }
 

@@ -285,7 +285,17 @@ struct Scene {
         float nx, ny, nz, k;  // the plane, each coordinate rounded to float
         float a, b;           // |s_float(e) - side| <= a * maxAbs(e) + b, rounded up
     };
-    std::vector<BackfacePlane> backfacePlanes;
+    // Stored as six float arrays (structure of arrays: the stage's loop runs four or eight
+    // triangles per instruction); backfacePlane(i) reads one entry.
+    struct BackfacePlanes {
+        std::vector<float> nx, ny, nz, k, a, b;
+        size_t size() const { return nx.size(); }
+        void resize(size_t n) { nx.resize(n), ny.resize(n), nz.resize(n), k.resize(n), a.resize(n), b.resize(n); }
+        void set(size_t i, const BackfacePlane &p) { nx[i] = p.nx, ny[i] = p.ny, nz[i] = p.nz, k[i] = p.k, a[i] = p.a, b[i] = p.b; }
+        BackfacePlane operator[](size_t i) const { return {nx[i], ny[i], nz[i], k[i], a[i], b[i]}; }
+        uint64_t bytes() const { return 6 * sizeof(float) * nx.capacity(); }
+    };
+    BackfacePlanes backfacePlanes;
     std::vector<SceneObject> objects;
     std::vector<SourceObject> sources;
     std::vector<Material> materials;

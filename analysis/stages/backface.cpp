@@ -117,27 +117,40 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
             nk += n;
         } else {
             st.trianglesTested += n;
-            for (uint32_t i = ob.triBegin; i < ob.triEnd; ++i) {
-                const uint32_t t = tris[i];
-                int side = 0;
-                if (floatFilter) {
-                    const Scene::BackfacePlane &q = scene.backfacePlanes[i];
-                    const float sf = ((q.nx * ex + q.ny * ey) + q.nz * ez) + q.k;
-                    const float bound = q.a * M + q.b;
-                    side = sf > bound ? 1 : (sf < -bound ? -1 : 0);
+            // Pass 1 (vectorizable): the float filter's verdict per triangle, +1 front, -1 back, 0
+            // undecided. Pass 2: the undecided ones by the double and exact tests, and the output.
+            thread_local std::vector<int8_t> sides;
+            sides.resize(n);
+            int8_t *side = sides.data();
+            if (floatFilter) {
+                const Scene::BackfacePlanes &q = scene.backfacePlanes;
+                const float *qx = q.nx.data() + ob.triBegin, *qy = q.ny.data() + ob.triBegin,
+                            *qz = q.nz.data() + ob.triBegin, *qk = q.k.data() + ob.triBegin,
+                            *qa = q.a.data() + ob.triBegin, *qb = q.b.data() + ob.triBegin;
+                for (uint32_t j = 0; j < n; ++j) {
+                    const float sf = ((qx[j] * ex + qy[j] * ey) + qz[j] * ez) + qk[j];
+                    const float bound = qa[j] * M + qb[j];
+                    side[j] = int8_t((sf > bound) - (sf < -bound));
                 }
+            } else {
+                std::fill(side, side + n, int8_t(0));
+            }
+            const uint32_t *tris = scene.objectTriangles.data() + ob.triBegin;
+            for (uint32_t j = 0; j < n; ++j) {
+                const uint32_t t = tris[j];
+                int sd = side[j];
                 bool edgeOn = false;
-                if (side == 0) {
+                if (sd == 0) {
                     // isFrontFacing's double filter with the eye's magnitude taken once; only where it
                     // cannot decide does the full test run.
-                    side = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
-                    if (side == 0) side = isFrontFacing(scene, t, cam, &edgeOn) ? 1 : -1;
+                    sd = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
+                    if (sd == 0) sd = isFrontFacing(scene, t, cam, &edgeOn) ? 1 : -1;
                 }
                 kept[nk] = t;
                 culled[nc] = t;
-                nk += side > 0;
-                nc += side < 0;
-                st.edgeOn += edgeOn && side < 0;  // an edge-on triangle kept (orthographic) is not counted
+                nk += sd > 0;
+                nc += sd < 0;
+                st.edgeOn += edgeOn && sd < 0;  // an edge-on triangle kept (orthographic) is not counted
             }
         }
         if (nk > begin) {  // objects with every triangle culled leave no group
