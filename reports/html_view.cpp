@@ -3,7 +3,6 @@
 #include <cmath>
 #include <set>
 
-#include "render/depth_format.h"
 #include "reports/html_parts.h"
 
 namespace va::html {
