@@ -40,7 +40,8 @@ Rgb8 disagreementColor(Disagreement d) {
     return {0, 0, 0};
 }
 
-bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, const std::string &path, std::string *err) {
+bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, const std::string &path, std::string *err,
+                       const std::vector<uint8_t> *grays) {
     const int W = ref.width, H = ref.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
     if (W <= 0 || H <= 0 || ref.id.size() != n || audit.fate.size() != n) {
@@ -48,7 +49,7 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
                         std::to_string(W) + "x" + std::to_string(H) + " buffers";
         return false;
     }
-    const DepthGrayScale gray = depthGrayScale(ref.depth);
+    const PixelGrays gray(ref.depth, grays);
     std::vector<uint8_t> img(n * 3);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
@@ -56,7 +57,7 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
             const uint8_t f = audit.fate[i];
             Rgb8 c{0, 0, 0};
             if (f == kFateDrawn) {
-                const uint8_t g = gray(ref.depth[i]);
+                const uint8_t g = gray[i];
                 c = {uint8_t(g * kCullDrawnTint.r / 255), uint8_t(g * kCullDrawnTint.g / 255),
                      uint8_t(g * kCullDrawnTint.b / 255)};
             } else if (f == kFateUnaccounted) {
@@ -86,7 +87,8 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
     return writePngRgb8(path, W, CH, rgb.data(), err);
 }
 
-bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err) {
+bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err,
+                           const std::vector<uint8_t> *grays) {
     const int W = zb.width, H = zb.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
     if (W <= 0 || H <= 0 || zb.depth.size() != n || check.cls.size() != n) {
@@ -94,13 +96,13 @@ bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std
                         std::to_string(W) + "x" + std::to_string(H) + " buffers";
         return false;
     }
-    const DepthGrayScale gray = depthGrayScale(zb.depth);
+    const PixelGrays gray(zb.depth, grays);
     std::vector<uint8_t> img(n * 3);
     for (size_t i = 0; i < n; ++i) {
         const Disagreement d = Disagreement(check.cls[i]);
         Rgb8 c;
         if (d == Disagreement::none) {
-            const uint8_t g = uint8_t(gray(zb.depth[i]) / 4);  // dimmed: the classes stand out
+            const uint8_t g = uint8_t(gray[i] / 4);  // dimmed: the classes stand out
             c = {g, g, g};
         } else {
             c = disagreementColor(d);

@@ -36,9 +36,13 @@ constexpr Rgb8 kCullBeyondFarPlane{0, 120, 120};  // culled beyond the map's des
 Rgb8 disagreementColor(Disagreement d);  // none: black (not used: the dimmed image shows)
 
 // BASE.culling.png from a view's reference and culling audit.
-bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, const std::string &path, std::string *err);
+// grays: the reference depth's depthGrays when the caller has them (else computed here).
+bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, const std::string &path, std::string *err,
+                       const std::vector<uint8_t> *grays = nullptr);
 // BASE.raycast_diff.png from the z-buffer's depths (the dimmed background) and a cross-check.
-bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err);
+// grays: the z-buffer depth's depthGrays when the caller has them (else computed here).
+bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err,
+                           const std::vector<uint8_t> *grays = nullptr);
 // BASE.raycast.ids.exr.
 bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err);
 

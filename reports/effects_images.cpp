@@ -25,10 +25,10 @@ bool sizesMatch(const EffectsResult &fx, const ZBuffer &zb, const std::string &p
 }  // namespace
 
 bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, const std::string &path,
-                      std::string *err) {
+                      std::string *err, const std::vector<uint8_t> *grays) {
     if (!sizesMatch(fx, zb, path, err)) return false;
     const int W = zb.width, H = zb.height;
-    const DepthGrayScale gray = depthGrayScale(zb.depth);
+    const PixelGrays gray(zb.depth, grays);
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     // A visible pixel is lit, shadowed or facing away; the ray caster's visibility decides which
     // pixels are visible, so lit = visible and neither of the other two.
@@ -40,7 +40,7 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
             if (fx.shadowed(light, x, y)) {
                 c = kShadowed;
             } else {
-                const uint8_t g = gray(zb.depth[i]);
+                const uint8_t g = gray[i];
                 c = {g, g, g};
             }
             img[3 * i] = c.r, img[3 * i + 1] = c.g, img[3 * i + 2] = c.b;
@@ -55,10 +55,11 @@ bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, 
     return writePngRgb8(path, W, CH, rgb.data(), err);
 }
 
-bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::string &path, std::string *err) {
+bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::string &path, std::string *err,
+                         const std::vector<uint8_t> *grays) {
     if (!sizesMatch(fx, zb, path, err)) return false;
     const int W = zb.width, H = zb.height;
-    const DepthGrayScale gray = depthGrayScale(zb.depth);
+    const PixelGrays gray(zb.depth, grays);
     // Depth 1..8+ on the overdraw ramp; 0 (no secondary ray) shows the depth image dimmed.
     std::vector<uint8_t> img(size_t(W) * size_t(H) * 3, 0);
     int deepest = 0;
@@ -69,7 +70,7 @@ bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::
         if (k > 0) {
             c = overdrawColor(uint32_t(k), 8);
         } else {
-            const uint8_t g = uint8_t(gray(zb.depth[i]) / 3);
+            const uint8_t g = uint8_t(gray[i] / 3);
             c = {g, g, g};
         }
         img[3 * i] = c.r, img[3 * i + 1] = c.g, img[3 * i + 2] = c.b;

@@ -13,8 +13,10 @@
 
 namespace va {
 
+// grays (both): the z-buffer depth's depthGrays when the caller has them (else computed here).
 bool writeShadowImage(const EffectsResult &fx, size_t light, const ZBuffer &zb, const std::string &path,
-                      std::string *err);
-bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::string &path, std::string *err);
+                      std::string *err, const std::vector<uint8_t> *grays = nullptr);
+bool writeSecondaryImage(const EffectsResult &fx, const ZBuffer &zb, const std::string &path, std::string *err,
+                         const std::vector<uint8_t> *grays = nullptr);
 
 }  // namespace va

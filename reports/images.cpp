@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <optional>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -194,6 +195,13 @@ void depthRange(const std::vector<double> &depth, double *dMin, double *dMax) {
 
 uint8_t depthGray(double d, double dMin, double dMax) { return DepthGrayScale(dMin, dMax)(d); }
 
+std::vector<uint8_t> depthGrays(const std::vector<double> &depth) {
+    const DepthGrayScale scale = depthGrayScale(depth);
+    std::vector<uint8_t> g(depth.size());
+    for (size_t i = 0; i < depth.size(); ++i) g[i] = scale(depth[i]);
+    return g;
+}
+
 // ---- Writing ----------------------------------------------------------------------------------
 
 bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
@@ -211,6 +219,17 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     }
     const ViewImageNames names = viewImageNames(baseName);
     const std::string prefix = dir.empty() ? std::string() : (dir.back() == '/' ? dir : dir + "/");
+    // The grays of the z-buffer's and the reference's depths, computed once for every image drawn
+    // over them (depthGrays), when the first such image is written.
+    std::optional<std::vector<uint8_t>> zGraysMemo, refGraysMemo;
+    auto zGrays = [&]() -> const std::vector<uint8_t> * {
+        if (!zGraysMemo) zGraysMemo = depthGrays(zb.depth);
+        return &*zGraysMemo;
+    };
+    auto refGrays = [&]() -> const std::vector<uint8_t> * {
+        if (!refGraysMemo) refGraysMemo = depthGrays(view.audit->reference.depth);
+        return &*refGraysMemo;
+    };
 
     // BASE.depth.exr: view depth as float, +inf where nothing was drawn.
     if (want("depth_exr")) {
@@ -224,14 +243,9 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.depth.png: log-scaled gray between the view's nearest and farthest finite depth.
     if (want("depth_png")) {
-        double dMin, dMax;
-        depthRange(zb.depth, &dMin, &dMax);
-        const DepthGrayScale scale(dMin, dMax);
-        std::vector<uint8_t> gray(n);
-        for (size_t i = 0; i < n; ++i) gray[i] = scale(zb.depth[i]);
         ImageSpec spec(W, H, 1, TypeDesc::UINT8);
         spec.channelnames = {"Y"};
-        if (!writeImageAtomic(prefix + names.depthPng, "png", spec, gray.data(), err)) return false;
+        if (!writeImageAtomic(prefix + names.depthPng, "png", spec, zGrays()->data(), err)) return false;
     }
 
     // BASE.overdraw.png: heatmap of fragments per pixel, scale capped at max(8, most fragments), with
@@ -284,15 +298,17 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     }
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
-    if (view.zfight.ran() && want("zfight_png") && !writeZFightImage(*view.zfight, zb, prefix + names.zfightPng, err)) return false;
+    if (view.zfight.ran() && want("zfight_png") && !writeZFightImage(*view.zfight, zb, prefix + names.zfightPng, err, zGrays()))
+        return false;
     // BASE.culling.png: the reference visibility colored by each pixel's fate (reports/audit_images.h).
-    if (view.audit.ran() && want("culling_png") && !writeCullingImage(view.audit->reference, view.audit->cull, prefix + names.cullingPng, err))
+    if (view.audit.ran() && want("culling_png") && !writeCullingImage(view.audit->reference, view.audit->cull, prefix + names.cullingPng, err, refGrays()))
         return false;
     // Draw orders: painter's errors, overdraw by order, the A-buffer composite (reports/ordering_images.h).
     if (view.ordering.ran() && view.audit.ran()) {
         const OrderingImageNames on = orderingImageNames(names.base);
         if (want("painter_errors_png") &&
-            !writePainterErrorsImage(view.audit->reference, view.ordering->painter, prefix + on.painterErrorsPng, err))
+            !writePainterErrorsImage(view.audit->reference, view.ordering->painter, prefix + on.painterErrorsPng, err,
+                                     refGrays()))
             return false;
         if (want("overdraw_order_png") &&
             !writeOverdrawByOrderChart(view.ordering->overdrawByOrder, prefix + on.overdrawOrderPng, err))
@@ -306,14 +322,16 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
         const RaycastImage &image = view.raycast->image;
         if (want("raycast_ids_exr") && !writeRaycastIds(image.width, image.height, image.id, prefix + names.raycastIdsExr, err))
             return false;
-        if (want("raycast_diff_png") && !writeRaycastDiffImage(zb, view.raycast->crossCheck, prefix + names.raycastDiffPng, err))
+        if (want("raycast_diff_png") && !writeRaycastDiffImage(zb, view.raycast->crossCheck, prefix + names.raycastDiffPng, err, zGrays()))
             return false;
     }
     // Secondary rays: one shadow image per light, the depth of the ray trees (reports/effects_images.h).
     if (view.effects.ran()) {
         for (size_t l = 0; l < view.effects->lights.size() && want("shadow_png"); ++l)
-            if (!writeShadowImage(*view.effects, l, zb, prefix + shadowImageName(names, l, view), err)) return false;
-        if (want("secondary_png") && !writeSecondaryImage(*view.effects, zb, prefix + names.secondaryPng, err)) return false;
+            if (!writeShadowImage(*view.effects, l, zb, prefix + shadowImageName(names, l, view), err, zGrays()))
+                return false;
+        if (want("secondary_png") && !writeSecondaryImage(*view.effects, zb, prefix + names.secondaryPng, err, zGrays()))
+            return false;
     }
     return true;
 }

@@ -32,11 +32,12 @@ OrderingImageNames orderingImageNames(const std::string &baseName) {
     return {baseName + ".painter_errors.png", baseName + ".overdraw_order.png", baseName + ".abuffer.png"};
 }
 
-std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH) {
+std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH,
+                                         const std::vector<uint8_t> *grays) {
     const int W = ref.width, H = ref.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
     // The reference's depths as the dimmed gray background (log scale, as depth.png).
-    const DepthGrayScale gray = depthGrayScale(ref.depth);
+    const PixelGrays gray(ref.depth, grays);
     const int scale = W >= 1024 ? 2 : 1;
     const int strip = 13 * scale;
     *canvasH = H + strip;
@@ -47,7 +48,7 @@ std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const P
         else if (painter.cls[i] == kOrderTie) c = kOrderTieColor;
         else if (painter.cls[i] == kOrderEdge) c = kOrderEdgeColor;
         else if (ref.id[i]) {
-            const uint8_t g = uint8_t(gray(ref.depth[i]) / 2);
+            const uint8_t g = uint8_t(gray[i] / 2);
             c = {g, g, g};
         }
         uint8_t *p = &rgb[i * 3];
@@ -68,14 +69,14 @@ std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const P
 }
 
 bool writePainterErrorsImage(const ReferenceVisibility &ref, const PainterResult &painter, const std::string &path,
-                             std::string *err) {
+                             std::string *err, const std::vector<uint8_t> *grays) {
     const size_t n = size_t(std::max(ref.width, 0)) * size_t(std::max(ref.height, 0));
     if (n == 0 || ref.id.size() != n || painter.cls.size() != n) {
         if (err) *err = "cannot write image '" + path + "': the painter's per-pixel classes do not match the reference";
         return false;
     }
     int h = 0;
-    const std::vector<uint8_t> rgb = renderPainterErrors(ref, painter, &h);
+    const std::vector<uint8_t> rgb = renderPainterErrors(ref, painter, &h, grays);
     return writePngRgb8(path, ref.width, h, rgb.data(), err);
 }
 

@@ -31,9 +31,11 @@ constexpr Rgb8 kOrderTieColor{255, 220, 0};
 constexpr Rgb8 kOrderEdgeColor{64, 128, 255};
 
 // The painter-errors picture as RGB8 (width x (height + legend)); *canvasH receives its height.
-std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH);
+// grays (both): the reference depth's depthGrays when the caller has them (else computed here).
+std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH,
+                                         const std::vector<uint8_t> *grays = nullptr);
 bool writePainterErrorsImage(const ReferenceVisibility &ref, const PainterResult &painter, const std::string &path,
-                             std::string *err);
+                             std::string *err, const std::vector<uint8_t> *grays = nullptr);
 
 // The bar chart as RGB8, kOverdrawChartWidth wide; *canvasH receives its height.
 constexpr int kOverdrawChartWidth = 480;

@@ -150,6 +150,24 @@ inline DepthGrayScale depthGrayScale(const std::vector<double> &depth) {
     return DepthGrayScale(lo, hi);
 }
 
+// A depth buffer's gray per pixel (depthGrayScale over its own range): computed once per view and
+// shared by every image drawn over that buffer (a logarithm per pixel, not one per pixel and image).
+std::vector<uint8_t> depthGrays(const std::vector<double> &depth);
+// An image writer's grays by pixel: the caller's shared ones (depthGrays of the same buffer) when
+// given, else computed here; the same bytes either way.
+class PixelGrays {
+  public:
+    PixelGrays(const std::vector<double> &depth, const std::vector<uint8_t> *shared)
+        : depth_(depth), shared_(shared && shared->size() == depth.size() ? shared->data() : nullptr),
+          scale_(shared_ ? DepthGrayScale(0, 0) : depthGrayScale(depth)) {}
+    uint8_t operator[](size_t i) const { return shared_ ? shared_[i] : scale_(depth_[i]); }
+
+  private:
+    const std::vector<double> &depth_;
+    const uint8_t *shared_;
+    DepthGrayScale scale_;
+};
+
 // ---- Files and folders -----------------------------------------------------------------------
 // Reads and parses a JSON file (a report, a baseline, a submission). `unreadable`: the file cannot
 // be opened or read; `invalid`: not JSON, *detail gets the parser's message. Callers word the error.

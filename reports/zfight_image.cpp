@@ -54,7 +54,8 @@ struct LegendEntry {
 
 Rgb8 zfightHotspotColor(uint32_t id) { return kPalette[(id == 0 ? 0 : id - 1) % 12]; }
 
-bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *out, std::string *err) {
+bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *out, std::string *err,
+                       const std::vector<uint8_t> *grays) {
     const int W = zf.width, H = zf.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
     if (W <= 0 || H <= 0 || zb.width != W || zb.height != H || zb.depth.size() != n || zf.pixelClass.size() != n ||
@@ -101,11 +102,11 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     c.fill(0, 0, CW, CH, kZFightStripBackground);
 
     // 1. Dimmed gray view; 2. markers.
-    const DepthGrayScale gray = depthGrayScale(zb.depth);
+    const PixelGrays gray(zb.depth, grays);
     for (int y = 0; y < H; ++y)
         for (int xx = 0; xx < W; ++xx) {
             const size_t p = size_t(y) * size_t(W) + size_t(xx);
-            const uint8_t g = uint8_t(gray(zb.depth[p]) / 2);
+            const uint8_t g = uint8_t(gray[p] / 2);
             Rgb8 col{g, g, g};
             const auto cls = ZPixelClass(zf.pixelClass[p]);
             if (cls == ZPixelClass::shared_edge) col = kZFightSharedEdgeColor;
@@ -151,10 +152,11 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     return true;
 }
 
-bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::string &path, std::string *err) {
+bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::string &path, std::string *err,
+                      const std::vector<uint8_t> *grays) {
     ZFightImage img;
     std::string e;
-    if (!renderZFightImage(zf, zb, &img, &e)) {
+    if (!renderZFightImage(zf, zb, &img, &e, grays)) {
         if (err) *err = "cannot write image '" + path + "': " + e;
         return false;
     }

@@ -40,13 +40,16 @@ struct ZFightImage {
 
 // Composes the image from the analysis and the view's z-buffer (its visible depth is the gray
 // background). Returns false with *err when the two do not have the same width x height.
-bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *out, std::string *err);
+bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *out, std::string *err,
+                       const std::vector<uint8_t> *grays = nullptr);
 
 // BASE.zfight.png
 inline std::string zfightImageName(const std::string &baseName) { return baseName + ".zfight.png"; }
 
 // Renders and writes the PNG at `path` (temporary name in the same folder, then renamed). On
 // failure returns false with the path and the reason.
-bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::string &path, std::string *err);
+// grays: the z-buffer depth's depthGrays when the caller has them (else computed here).
+bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::string &path, std::string *err,
+                      const std::vector<uint8_t> *grays = nullptr);
 
 }  // namespace va
