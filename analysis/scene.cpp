@@ -148,7 +148,9 @@ static float roundUpToFloat(double x) {
     return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
-Scene::BackfacePlane backfacePlaneOf(const double *plane, double A, double V) {
+// The filter's entry for a plane (4 doubles n.x n.y n.z k), A = |n|_1 and V = the largest
+// |coordinate| of its vertices.
+static Scene::BackfacePlane backfacePlaneOf(const double *plane, double A, double V) {
     constexpr double u = 0x1p-24;
     const double k = plane[3];
     return {float(plane[0]), float(plane[1]), float(plane[2]), float(k),

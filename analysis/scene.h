@@ -279,14 +279,14 @@ struct Scene {
                                           //   test's rounding bound, isFrontFacing); 0 when excluded
     // The backface stage's streaming filter, one per Scene::objectTriangles entry (in that order,
     // so the stage reads it front to back): the plane rounded to float and a bound on the error of
-    // evaluating it in float at an eye e (backface.cpp derives it). Empty: the stage uses only the
+    // evaluating it in float at an eye e (scene.cpp derives it). Empty: the stage uses only the
     // double test.
     struct BackfacePlane {
         float nx, ny, nz, k;  // the plane, each coordinate rounded to float
         float a, b;           // |s_float(e) - side| <= a * maxAbs(e) + b, rounded up
     };
     // Stored as six float arrays (structure of arrays: the stage's loop runs four or eight
-    // triangles per instruction); backfacePlane(i) reads one entry.
+    // triangles per instruction); operator[] reads one entry.
     struct BackfacePlanes {
         std::vector<float> nx, ny, nz, k, a, b;
         size_t size() const { return nx.size(); }
@@ -341,9 +341,5 @@ bool buildScene(SceneBuildInput &&in, const ChunkSettings &chunks, Scene *out, s
 // Convenience for trusted input (tests, generated scenes): throws std::runtime_error where the
 // overload above returns false. Loaders use the overload above.
 Scene buildScene(SceneBuildInput &&in, const ChunkSettings &chunks = {});
-
-// The backface filter's entry for a plane (4 doubles n.x n.y n.z k), A = |n|_1 and V = the largest
-// |coordinate| of its vertices (scene.cpp derives the bound).
-Scene::BackfacePlane backfacePlaneOf(const double *plane, double A, double V);
 
 }  // namespace va

@@ -397,12 +397,12 @@ void HtmlWriter::depthFormats(const Json *v, const std::string &id) {
     const Json *curves = get(&report, "depth_curves");
     const auto k = num(v, {"depth_curve"});
     if (!curves || !curves->is_array() || !k || !(*k >= 0 && *k < double(curves->size()))) return;
-    const Json *curve = &(*curves)[size_t(*k)];
+    const size_t set = size_t(*k);
+    const Json *curve = &(*curves)[set];
     std::vector<std::pair<std::string, double>> markers;
     if (const Json *hs = get(d, "hotspots"); hs && hs->is_array())
         for (const Json &h : *hs)
             if (auto dep = num(get(&h, "depth")); dep && markers.size() < 12) markers.emplace_back("#" + fmtValue(get(&h, "id")), *dep);
-    const size_t set = size_t(*k);
     const std::string svg = resolutionSvg(curve, own, markers, id + "-resolution", "depth-curves-" + std::to_string(set),
                                           curvesDrawn.insert(set).second);
     if (svg.empty()) return;

@@ -174,6 +174,8 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
             auto [it, added] = curveIndex.emplace(c.dump(), curves.size());
             if (added) curves.push_back(c);
             v["depth_curve"] = it->second;
+        } else if (v.contains("depth_curve")) {
+            v["depth_curve"] = nullptr;  // an index into no set of its shard: no plot, never another set's
         }
         list.push_back(std::move(v));
     }

@@ -110,10 +110,10 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
         const SceneObject &ob = scene.objects[o];
         const size_t begin = nk;
         const uint32_t n = ob.triEnd - ob.triBegin;
-        const uint32_t *tris = scene.objectTriangles.data();
+        const uint32_t *tris = scene.objectTriangles.data() + ob.triBegin;
         if (scene.materialOf(ob).doubleSided) {
             st.doubleSidedExempt += n;
-            std::copy(tris + ob.triBegin, tris + ob.triEnd, kept + nk);
+            std::copy(tris, tris + n, kept + nk);
             nk += n;
         } else {
             st.trianglesTested += n;
@@ -135,17 +135,12 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
             } else {
                 std::fill(side, side + n, int8_t(0));
             }
-            const uint32_t *tris = scene.objectTriangles.data() + ob.triBegin;
             for (uint32_t j = 0; j < n; ++j) {
                 const uint32_t t = tris[j];
                 int sd = side[j];
                 bool edgeOn = false;
-                if (sd == 0) {
-                    // isFrontFacing's double filter with the eye's magnitude taken once; only where it
-                    // cannot decide does the full test run.
-                    sd = cam.orthographic ? 0 : filteredSide(scene, t, cam.eye, eyeMax);
-                    if (sd == 0) sd = isFrontFacing(scene, t, cam, &edgeOn) ? 1 : -1;
-                }
+                // Undecided: isFrontFacing's double filter, then the exact test where that cannot decide.
+                if (sd == 0) sd = isFrontFacing(scene, t, cam, &edgeOn) ? 1 : -1;
                 kept[nk] = t;
                 culled[nc] = t;
                 nk += sd > 0;
