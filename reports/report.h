@@ -181,8 +181,10 @@ JsonRead readJsonDocument(const std::string &path, nlohmann::ordered_json *out, 
 // is invisible until OutputDir::commit, which flushes it as a whole before the swap, so a temporary
 // name and a flush per file (one journal commit each: 5 ms per image here) buy nothing there.
 bool writeFileAtomic(const std::string &path, const std::string &contents, std::string *err);
-// Images written the same way (OpenImageIO, temporary name in the same folder, then rename), for
-// the other image writers of reports/: an interleaved RGB8 PNG, and a one-channel UINT32 EXR (ids).
+// Images written the same way, for the other image writers of reports/: an interleaved RGB8 PNG
+// (libpng; stored with a palette when it has at most 256 colors, as every visualization here does:
+// the same pixels read back, a third of the bytes to compress), and a one-channel UINT32 EXR (ids,
+// OpenImageIO).
 bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err);
 bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
                     std::string *err);
