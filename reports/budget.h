@@ -52,6 +52,7 @@ struct BudgetCheck {
     std::string allowed;     // the limit (formatted)
     bool pass = true;
     std::string message;     // e.g. "overdraw in view 'atrium' rose 23%, allowed 10%"
+    std::string frame;       // a route's frame: "frame 12 of route 'atrium-run' at 1.5 s" (else empty)
 };
 struct BudgetResult {
     std::vector<BudgetCheck> checks;  // views in report order, metrics in budgetMetrics() order
@@ -74,7 +75,8 @@ bool evaluatePvsBudget(const Budget &budget, const nlohmann::ordered_json &pvsAu
 
 // A console table of every check (failures first), and the summary line.
 std::string budgetTable(const BudgetResult &r);
-// JUnit XML: one test suite, one test case per view and budget, failures with their message.
+// JUnit XML: one test suite, one test case per view and budget, failures with their message; a
+// route's frame names the frame and its time in the test case's name.
 std::string budgetJUnit(const BudgetResult &r, const std::string &suiteName);
 
 }  // namespace va
