@@ -223,7 +223,7 @@ std::vector<DepthFormatSpec> budgetDepthFormats(const Budget &budget) {
 }
 
 bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *baseline, BudgetResult *out,
-                    std::string *err) {
+                    std::string *err, const BudgetEvaluation &how) {
     BudgetResult r;
     if (baseline) {
         if (!baseline->contains("format") || (*baseline)["format"] != report["format"]) {
@@ -232,7 +232,7 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
             return false;
         }
         if ((*baseline)["scene"]["path"] != report["scene"]["path"] ||
-            (*baseline)["scene"]["source_triangles"] != report["scene"]["source_triangles"]) {
+            (how.sameTriangles && (*baseline)["scene"]["source_triangles"] != report["scene"]["source_triangles"])) {
             *err = "the baseline is a report of another scene (" + (*baseline)["scene"]["path"].get<std::string>() +
                    ", " + std::to_string((*baseline)["scene"]["source_triangles"].get<uint64_t>()) +
                    " triangles); give the baseline of " + report["scene"]["path"].get<std::string>();
@@ -253,10 +253,13 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
         if (!frame.empty()) frames[name] = frame;
         // Limits: the scene-wide ones, overridden per view; false_culls defaults to 0 where the
         // report has the audit.
-        std::map<std::string, nlohmann::json> limits = budget.limits;
-        if (auto it = budget.views.find(name); it != budget.views.end())
-            for (const auto &[k, v] : it->second) limits[k] = v;
-        if (!limits.count("false_culls") && metricValue("false_culls", view)) limits["false_culls"] = 0;
+        std::map<std::string, nlohmann::json> limits;
+        if (how.limits) {
+            limits = budget.limits;
+            if (auto it = budget.views.find(name); it != budget.views.end())
+                for (const auto &[k, v] : it->second) limits[k] = v;
+            if (!limits.count("false_culls") && metricValue("false_culls", view)) limits["false_culls"] = 0;
+        }
 
         for (const BudgetMetric &m : budgetMetrics()) {
             auto lim = limits.find(m.name);

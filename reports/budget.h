@@ -59,10 +59,18 @@ struct BudgetResult {
     size_t failed = 0;
 };
 
+// What evaluateBudget checks: `limits` (check: the limits and the regressions; diff: the
+// regressions only), and whether a baseline must be of the same geometry (check: same scene path
+// and source triangles; diff compares two versions of one level: the same scene path).
+struct BudgetEvaluation {
+    bool limits = true;
+    bool sameTriangles = true;
+};
 // Checks the report (and, with a baseline report, the regressions). False + message when the
 // report lacks what a budget needs, or the baseline is of another scene or report format.
 bool evaluateBudget(const Budget &budget, const nlohmann::ordered_json &report,
-                    const nlohmann::ordered_json *baseline, BudgetResult *out, std::string *err);
+                    const nlohmann::ordered_json *baseline, BudgetResult *out, std::string *err,
+                    const BudgetEvaluation &how = {});
 
 // Whether the budget names a map-wide metric (pvs_*): `check` then runs the PVS audit too.
 bool budgetNeedsPvsAudit(const Budget &budget);

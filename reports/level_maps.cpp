@@ -220,7 +220,10 @@ Canvas levelMapImage(const Json &lm, size_t mi, const Canvas &floor, const Json 
             int x, y;
             pixelOf(k, &x, &y);
             const std::string label = fmtCount(numOr(&w, {"rank"}, 0));
-            const int lx = std::min(x + r + 2 * s, W - textWidth(label, s) - s), ly = std::clamp(y - textHeight(s) / 2, s, H - textHeight(s) - s);
+            // Right of the dot, or left of it where the map ends.
+            const int tw = textWidth(label, s);
+            const int lx = x + r + 2 * s + tw + s <= W ? x + r + 2 * s : std::max(s, x - r - 2 * s - tw);
+            const int ly = std::clamp(y - textHeight(s) / 2, s, H - textHeight(s) - s);
             c.label(lx, ly, label, kText, kOutline, s);
         }
 
@@ -250,14 +253,15 @@ Canvas levelMapImage(const Json &lm, size_t mi, const Canvas &floor, const Json 
 bool readCanvas(const std::string &path, Canvas *out, std::string *err) {
     ImageData im;
     if (!readImage(path, &im, err)) return false;
-    if (im.pixelType != "uint8" || im.channels() < 3) {
-        *err = path + ": expected an 8-bit RGB PNG (the level map's floor plan)";
+    if (im.pixelType != "uint8" || im.channels() < 1) {
+        *err = path + ": expected an 8-bit PNG (gray or RGB), as visaudit writes them";
         return false;
     }
     Canvas c(im.width, im.height, {});
     const int ch = im.channels();
+    // Gray (and gray + alpha) as three equal channels; RGB(A) as its first three.
     for (size_t p = 0; p < size_t(im.width) * size_t(im.height); ++p)
-        for (int k = 0; k < 3; ++k) c.rgb[3 * p + size_t(k)] = im.u8[size_t(ch) * p + size_t(k)];
+        for (int k = 0; k < 3; ++k) c.rgb[3 * p + size_t(k)] = im.u8[size_t(ch) * p + size_t(ch >= 3 ? k : 0)];
     *out = std::move(c);
     return true;
 }

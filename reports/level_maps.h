@@ -49,7 +49,8 @@ Canvas levelMapImage(const nlohmann::ordered_json &levelMaps, size_t m, const Ca
                      const nlohmann::ordered_json &views, bool diff = false);
 // Reads dir/level-map-floor.png and writes every map into dir, setting each map's "image".
 bool writeLevelMapImages(nlohmann::ordered_json *report, const std::string &dir, std::string *err);
-// A PNG read back as an RGB canvas (the floor plan); false + message naming the file.
+// An 8-bit PNG read back as an RGB canvas (the floor plan, a view's image; gray replicated);
+// false + message naming the file.
 bool readCanvas(const std::string &path, Canvas *out, std::string *err);
 
 }  // namespace va
