@@ -14,6 +14,7 @@ CommandRun setupAnalyze(CLI::App *c);     // cli/cmd_analyze.cpp
 CommandRun setupCheck(CLI::App *c);       // cli/cmd_analyze.cpp
 CommandRun setupGrade(CLI::App *c);       // cli/cmd_grade.cpp
 CommandRun setupMerge(CLI::App *c);       // cli/cmd_merge.cpp
+CommandRun setupDiff(CLI::App *c);        // cli/cmd_diff.cpp
 CommandRun setupDepthAudit(CLI::App *c);  // cli/cmd_depth_audit.cpp
 CommandRun setupPvsAudit(CLI::App *c);    // cli/cmd_pvs_audit.cpp
 

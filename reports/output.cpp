@@ -71,6 +71,7 @@ bool replaceable(const std::string &dir, std::string *why) {
     if (it == fs::directory_iterator()) return true;
     if (fs::is_regular_file(fs::path(dir) / "report.json", ec)) return true;
     if (fs::is_regular_file(fs::path(dir) / "pvs-audit.json", ec)) return true;
+    if (fs::is_regular_file(fs::path(dir) / "diff.json", ec)) return true;  // visaudit diff's folder
     *why = "refusing to replace '" + dir +
            "': it is not empty and holds no report.json, so it is not a visaudit report folder; "
            "choose another --out folder (or an empty one)";

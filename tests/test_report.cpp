@@ -338,6 +338,39 @@ TEST(ReportJson, QuakeMapSectionsValidate) {
 }
 
 // The validator must be able to fail, or the test above proves nothing.
+// Routes and level maps (docs/routes.md, docs/level-maps.md): a route's definition, its frames'
+// "route" and series, and the level maps' floor, positions and maps, valid against the schema.
+TEST(ReportJson, RoutesAndLevelMapsValidate) {
+    AnalysisResult r = syntheticResult();
+    Route route;
+    route.name = "walk";
+    route.file = "walk.route.json";
+    route.keyframes.resize(2);
+    route.keyframes[0].target = Vec3{0, 0, 0};
+    route.keyframes[1].time = 2;
+    route.sampling.kind = RouteSampling::Kind::every;
+    route.sampling.every = 0.5;
+    r.routes = {route};
+    r.views[0].spec.route = {"walk", 0, 0.0};
+    r.views[1].spec.route = {"walk", 1, 0.5};
+    FloorPlan f;
+    f.width = 40, f.height = 20, f.up = 'y', f.worldPerPixel = 0.5, f.drawnPixels = 7;
+    f.camera.orthographic = true, f.camera.eye = {0, 60, 0}, f.camera.target = {0, 59, 0}, f.camera.up = {0, 0, -1};
+    f.camera.orthoHeight = 10, f.camera.nearZ = 1, f.camera.farZ = 80, f.camera.width = 40, f.camera.height = 20;
+    r.floorPlan = f;
+    const Json report = reportJson(r);
+    ASSERT_TRUE(report.contains("routes"));
+    ASSERT_TRUE(report.contains("level_maps"));
+    EXPECT_EQ(report["routes"][0]["series"]["view"], (Json{0, 1}));
+    EXPECT_EQ(report["routes"][0]["sampling"], (Json{{"every_seconds", 0.5}}));
+    // The orthographic views stand at (0, 50, 0): on the plan, one position of four views.
+    ASSERT_EQ(report["level_maps"]["positions"].size(), 1u);
+    EXPECT_EQ(report["level_maps"]["positions"][0]["views"], (Json{1, 2, 3, 4}));
+    const auto errors = validateReport(loadSchema(), report);
+    for (const auto &e : errors) ADD_FAILURE() << e;
+    EXPECT_TRUE(errors.empty());
+}
+
 TEST(ReportJson, ValidatorRejectsBrokenReports) {
     const Json schema = loadSchema();
     const Json good = reportJson(syntheticResult());
