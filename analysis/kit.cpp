@@ -896,6 +896,10 @@ bool buildKit(const Scene &scene, const std::vector<ViewSpec> &views, const std:
     answers["assignment"] = fingerprint(assignment);
     answers["stages"] = stages;
     answers["kit_files"] = fingerprints;
+    // The answer files' own fingerprints: the grader trusts their shape only as written here.
+    OJson answerPrints;
+    for (const auto &f : files.answers) answerPrints[f.first] = fingerprint(f.second);
+    answers["answer_files"] = answerPrints;
 
     std::vector<std::pair<std::string, std::string>> kitFiles;
     kitFiles.push_back({"assignment.json", assignment});
@@ -910,7 +914,7 @@ bool buildKit(const Scene &scene, const std::vector<ViewSpec> &views, const std:
     kitFiles.push_back({"CONVENTIONS.md", kitConventions(ks, formats)});
     kitFiles.push_back({"scene.obj", sceneObj(scene, sceneLabel)});
     kitFiles.push_back({"views.json", prettyText(OJson{{"views", views1}})});
-    kitFiles.push_back({"template/submission.json", prettyText(templ)});
+    kitFiles.push_back({"template/submission.json", templ.dump(2, ' ', false, OJson::error_handler_t::replace) + "\n"});
     for (auto &f : files.kit) kitFiles.push_back(std::move(f));
     files.kit = std::move(kitFiles);
     files.answers.insert(files.answers.begin(), {"answers.json", prettyText(answers)});

@@ -149,8 +149,9 @@ std::string kitConventions(const KitSettings &ks, const std::vector<DepthFormatS
     o += "- Perspective: a triangle is front-facing when n·eye + k > 0. Exactly 0 (the eye in the plane) is "
          "*edge-on*: it covers no area and is culled (counted in `edge_on` and in `triangles_culled`). The sign is "
          "decided exactly (the reference uses exact predicates where double rounding could flip it).\n";
-    o += "- Orthographic: front-facing when n·(−forward) > 0; where that is within its rounding error the "
-         "triangle is kept.\n";
+    o += "- Orthographic: front-facing when s = n·(−forward) > −err, err = γ(4)·(|n.x·f.x| + |n.y·f.y| + |n.z·f.z|) "
+         "with f = forward and γ(4) = 4u/(1 − 4u), u = 2^−53: where the sign is within the rounding of the dot product "
+         "the triangle is kept (conservative). A culled triangle with s exactly 0 is counted in `edge_on`.\n";
     o += "- Double-sided triangles are never tested (`double_sided_exempt`) and always kept.\n\n";
     o += "## clip\n\n";
     o += "- Outcodes per corner: near d < near, far d > far, left x_c < −w, right x_c > w, bottom y_c < −w, top "

@@ -104,6 +104,10 @@ bool readAnswers(const std::string &dir, const Kit &kit, AnswerSet *out, std::st
             return failAt(json::Path{} / "kit_files" / rel,
                           "the answers were made for " + rel + ", which the kit " + kit.dir + " does not hold" + remake);
 
+    if (!root.contains("answer_files") || !root["answer_files"].is_object())
+        return failAt(json::Path{} / "answer_files", "expected an object of answer files and their fingerprints");
+    const json::Json &answerPrints = root["answer_files"];
+
     AnswerSet set;
     set.dir = dir;
     for (const KitView &v : kit.views) {
@@ -114,6 +118,13 @@ bool readAnswers(const std::string &dir, const Kit &kit, AnswerSet *out, std::st
             std::string t;
             if (!slurp(file, &t)) {
                 *err = file + ": file not found; the answers folder is incomplete (make it again with visaudit assignment)";
+                return false;
+            }
+            // Written by visaudit assignment and unchanged since (so its shape is the one the grader reads).
+            if (!answerPrints.contains(rel) || answerPrints[rel] != fingerprint(t)) {
+                *err = file + ": not the file visaudit assignment wrote for these answers (" +
+                       (answerPrints.contains(rel) ? "changed since" : "not listed in answers.json") +
+                       "); make the answers again with visaudit assignment";
                 return false;
             }
             OJson j;
@@ -143,6 +154,12 @@ bool readAnswers(const std::string &dir, const Kit &kit, AnswerSet *out, std::st
                            std::to_string(v.cam.height) + " ids; make the answers again with visaudit assignment";
                     return false;
                 }
+                for (uint32_t id : im.u32)
+                    if (id > kit.sourceTriangles) {
+                        *err = path + ": holds id " + std::to_string(id) + ", past the scene's " +
+                               std::to_string(kit.sourceTriangles) + " triangles; make the answers again with visaudit assignment";
+                        return false;
+                    }
                 a.ids = std::move(im.u32);
                 a.width = im.width;
                 a.height = im.height;
@@ -242,6 +259,50 @@ bool readCsvImage(const std::string &path, const std::string &shown, int W, int 
     return true;
 }
 
+// A PFM file (Paul Debevec's portable float map): "Pf" (one channel) or "PF" (three; the first is
+// used), the width and height, a scale whose sign gives the byte order (negative: little-endian),
+// then 32-bit floats row by row from the *bottom* row up. Read here rather than through
+// OpenImageIO, whose Debian build has no PFM writer and whose reader's row order is its own.
+bool readPfm(const std::string &path, const std::string &shown, int W, int H, Pixels *out, std::string *why) {
+    std::ifstream f(path, std::ios::binary);
+    std::string magic;
+    long w = 0, h = 0;
+    double scale = 0;
+    if (!(f >> magic >> w >> h >> scale) || (magic != "Pf" && magic != "PF") || w <= 0 || h <= 0 || scale == 0) {
+        *why = shown + ": not a PFM file (expected \"Pf\" or \"PF\", the width, the height and the scale)";
+        return false;
+    }
+    f.get();  // the single whitespace byte after the scale
+    if (w != W || h != H) {
+        *why = shown + " is " + std::to_string(w) + "x" + std::to_string(h) + "; the view is " + std::to_string(W) + "x" +
+               std::to_string(H);
+        return false;
+    }
+    const int channels = magic == "PF" ? 3 : 1;
+    const size_t n = size_t(W) * size_t(H);
+    std::vector<unsigned char> bytes(n * size_t(channels) * 4);
+    if (!f.read(reinterpret_cast<char *>(bytes.data()), std::streamsize(bytes.size()))) {
+        *why = shown + ": the file ends before its " + std::to_string(n) + " pixels";
+        return false;
+    }
+    const bool little = scale < 0;
+    Pixels px;
+    px.width = W;
+    px.height = H;
+    px.v.resize(n);
+    for (int row = 0; row < H; ++row)
+        for (int x = 0; x < W; ++x) {
+            const unsigned char *b = &bytes[(size_t(row) * size_t(W) + size_t(x)) * size_t(channels) * 4];
+            const uint32_t u = little ? uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24
+                                      : uint32_t(b[3]) | uint32_t(b[2]) << 8 | uint32_t(b[1]) << 16 | uint32_t(b[0]) << 24;
+            float v;
+            std::memcpy(&v, &u, 4);
+            px.v[size_t(H - 1 - row) * size_t(W) + size_t(x)] = v;  // stored bottom row first
+        }
+    *out = std::move(px);
+    return true;
+}
+
 // A per-pixel image as the student wrote it: PNG (8 or 16-bit, one channel; ids only), EXR or PFM
 // (the first channel), or CSV. `shown` names it in messages.
 bool readStudentImage(const std::string &path, const std::string &shown, bool depth, int W, int H, Pixels *out,
@@ -253,6 +314,7 @@ bool readStudentImage(const std::string &path, const std::string &shown, bool de
     }
     const std::string ext = lowerExt(path);
     if (ext == ".csv") return readCsvImage(path, shown, W, H, out, why);
+    if (ext == ".pfm") return readPfm(path, shown, W, H, out, why);
     if (ext != ".png" && ext != ".exr" && ext != ".pfm") {
         *why = shown + ": unknown image type '" + ext + "'; use .png (16-bit gray, ids only), .exr, .pfm or .csv";
         return false;
@@ -758,7 +820,13 @@ struct Grader {
         if (!name->is_string() || name->get<std::string>().empty())
             return item(v, st, key, r, "unreadable", false, "expected the image's file name, got " + dumps(*name));
         const std::string file = name->get<std::string>();
-        const fs::path path = fs::path(file).is_absolute() ? fs::path(file) : fs::path(subDir) / file;
+        // A file of the submission folder (or below it): the grader reads nothing else.
+        bool inside = !fs::path(file).is_absolute();
+        for (const fs::path &part : fs::path(file)) inside = inside && part != "..";
+        if (!inside)
+            return item(v, st, key, r, "unreadable", false,
+                        "'" + file + "' is not a file of the submission folder; name the image relative to it");
+        const fs::path path = fs::path(subDir) / file;
         Pixels px;
         std::string why;
         const bool depth = which == "depth";
@@ -812,7 +880,8 @@ struct Grader {
     void stage(const KitView &v, const StageAnswer &a, const OJson *block) {
         const Stage st = a.stage;
         const std::string saved = missingWhy;
-        if (!g.error.empty()) {
+        if (!missingWhy.empty()) {
+            // the submission or the view is missing as a whole: that is the reason
         } else if (!block) {
             missingWhy = "no \"" + std::string(stageName(st)) + "\" block for view '" + v.name + "' in submission.json";
         } else if (!block->is_object()) {
