@@ -296,7 +296,7 @@ bool parseBackface(const json::Doc &doc, BackfaceInput *out, std::string *err) {
         const Json &j = (*tris)[i];
         const Path p = Path{} / "triangles" / i;
         BackfaceInput::Triangle t;
-        const Json *id, *ds, *v;
+        const Json *id = nullptr, *ds = nullptr, *v = nullptr;
         if (!r.object(j, p) || !(id = r.member(j, p, "id")) || !r.u32(*id, p / "id", &t.id) ||
             !(ds = r.member(j, p, "double_sided")) || !r.boolean(*ds, p / "double_sided", &t.doubleSided) ||
             !(v = r.member(j, p, "v")) || !r.array(*v, p / "v", 3))
@@ -321,7 +321,7 @@ bool parseClip(const json::Doc &doc, ClipInput *out, std::string *err) {
         const Json &j = (*tris)[i];
         const Path p = Path{} / "triangles" / i;
         uint32_t id = 0;
-        const Json *idj, *v;
+        const Json *idj = nullptr, *v = nullptr;
         if (!r.object(j, p) || !(idj = r.member(j, p, "id")) || !r.u32(*idj, p / "id", &id) ||
             !(v = r.member(j, p, "v")) || !r.array(*v, p / "v", 3))
             return false;
@@ -366,7 +366,7 @@ bool parseZBuffer(const json::Doc &doc, ZBufferInput *out, std::string *err) {
         const Path p = Path{} / "triangles" / i;
         uint32_t id = 0;
         DepthPlane plane;
-        const Json *idj, *xy, *pl;
+        const Json *idj = nullptr, *xy = nullptr, *pl = nullptr;
         if (!r.object(j, p) || !(idj = r.member(j, p, "id")) || !r.u32(*idj, p / "id", &id) ||
             !(xy = r.member(j, p, "xy")) || !readXy(r, *xy, p / "xy", st) || !(pl = r.member(j, p, "plane")) ||
             !readPlane(r, *pl, p / "plane", &plane))
@@ -391,7 +391,7 @@ bool parsePainter(const json::Doc &doc, PainterInput *out, std::string *err) {
         PainterCandidate c;
         bool single = false;
         DepthPlane plane;
-        const Json *idj, *dj, *sj, *pl, *sc;
+        const Json *idj = nullptr, *dj = nullptr, *sj = nullptr, *pl = nullptr, *sc = nullptr;
         if (!r.object(j, p) || !(idj = r.member(j, p, "id")) || !r.u32(*idj, p / "id", &c.source) ||
             !(dj = r.member(j, p, "depths")) || !r.array(*dj, p / "depths", 3) ||
             !(sj = r.member(j, p, "single_sided")) || !r.boolean(*sj, p / "single_sided", &single) ||

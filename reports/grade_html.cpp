@@ -1,7 +1,9 @@
 // grade.html and the class's index.html (kit_grade.h): self-contained pages, as report.html is --
 // the project's CSS inline (reports/assets/report.css), the diff PNGs next to the page, no script,
 // no network. Every string from a submission or a kit is escaped (htmlEscape).
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 
 #include "reports/html.h"
@@ -15,6 +17,12 @@ namespace {
 using OJson = nlohmann::ordered_json;
 
 std::string esc(const std::string &s) { return htmlEscape(s); }
+// "kit" for "path/to/kit" and "path/to/kit/".
+std::string folderName(const std::string &dir) {
+    std::filesystem::path p(dir);
+    if (p.filename().empty()) p = p.parent_path();
+    return p.filename().string();
+}
 std::string pct(double share) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.1f%%", 100 * share);
@@ -29,8 +37,11 @@ tr.failed td { background: color-mix(in srgb, var(--bad) 7%, transparent); }
 .score { font-size: 2em; font-weight: 700; margin: 4px 0; }
 .hint { border-left: 4px solid var(--warn); background: var(--card); padding: 8px 12px; margin: 8px 0; }
 .hint b { color: var(--warn); }
+.hint::after { content: ""; display: block; clear: both; }
+.hint img.thumb { float: right; image-rendering: pixelated; margin: 0 0 4px 12px; border: 1px solid var(--border); }
 figure.diff { display: inline-block; margin: 6px 12px 6px 0; vertical-align: top; }
-figure.diff img { image-rendering: pixelated; min-width: 320px; max-width: 100%; border: 1px solid var(--border); }
+figure.diff { max-width: 520px; }
+figure.diff img { image-rendering: pixelated; max-width: 100%; height: auto; border: 1px solid var(--border); }
 table.stages td.bar { width: 240px; }
 .barbg { background: var(--skip); height: 10px; border-radius: 5px; overflow: hidden; }
 .barfg { background: var(--good); height: 10px; }
@@ -53,7 +64,7 @@ std::string bar(double share) {
 std::string gradeHtml(const KitGrade &g, const Kit &kit) {
     std::string o = head("grade: " + g.student);
     o += "<header><h1>Grade: " + esc(g.student) + "</h1><div class=\"meta\">visaudit " VISAUDIT_VERSION
-         " · kit " + esc(kit.dir) + " · " + std::to_string(kit.views.size()) + " view" + (kit.views.size() == 1 ? "" : "s") +
+         " · kit folder " + esc(folderName(kit.dir)) + " · " + std::to_string(kit.views.size()) + " view" + (kit.views.size() == 1 ? "" : "s") +
          " · stages";
     for (Stage st : kit.stages) o += std::string(" ") + stageName(st);
     o += "</div><div class=\"score " + std::string(g.failed ? "bad" : "good") + "\" id=\"score\">" + pct(g.score) + "</div>";
@@ -72,11 +83,35 @@ std::string gradeHtml(const KitGrade &g, const Kit &kit) {
              "</td></tr>";
     o += "</table></section>\n";
 
-    // Hints first: what to fix.
+    // Hints first: what to fix. One entry per mistake, with where it shows and, for an image's
+    // pattern, the diff picture with the most disagreeing pixels among them.
     if (!g.hints.empty()) {
         o += "<section class=\"block\" id=\"hints\"><h2>What to look at</h2>";
+        std::vector<std::string> ids;
         for (const GradeHint &h : g.hints)
-            o += "<p class=\"hint\"><b>" + esc(h.view) + " · " + esc(h.stage) + ":</b> " + esc(h.text) + "</p>";
+            if (std::find(ids.begin(), ids.end(), h.id) == ids.end()) ids.push_back(h.id);
+        for (const std::string &id : ids) {
+            std::string where;
+            const GradeHint *first = nullptr;  // the hint shown: the one whose picture differs most
+            const PixelGrade *pic = nullptr;
+            for (const GradeHint &h : g.hints) {
+                if (h.id != id) continue;
+                if (!first) first = &h;
+                where += (where.empty() ? "" : ", ") + h.view + " " + h.stage;
+                for (const PixelGrade &p : g.images)
+                    if (p.view == h.view && p.stage == h.stage && !p.diffFile.empty() &&
+                        (!pic || p.pixels - p.agree > pic->pixels - pic->agree)) {
+                        pic = &p;
+                        first = &h;
+                    }
+            }
+            o += "<div class=\"hint\">";
+            if (pic && (id == "fill_rule" || id == "tie_rule" || id == "depth_test_greater"))
+                o += "<img class=\"thumb\" src=\"" + esc(pic->diffFile) + "\" alt=\"" + esc(pic->view + " " + pic->stage) +
+                     " compared with the reference\" width=\"" + std::to_string(pic->diffWidth) + "\">";
+            o += "<b>" + esc(first->title) + "</b> <span class=\"muted\">(" + esc(where) + ")</span><br>" +
+                 esc(first->text) + "</div>";
+        }
         o += "</section>\n";
     }
 
@@ -95,7 +130,7 @@ std::string gradeHtml(const KitGrade &g, const Kit &kit) {
             o += "<h3>" + esc(sn) + " <span class=\"muted\">" + std::to_string(passed) + " of " + std::to_string(total) +
                  " passed</span></h3>";
             for (const GradeHint &h : g.hints)
-                if (h.view == v.name && h.stage == sn) o += "<p class=\"hint\"><b>Hint:</b> " + esc(h.text) + "</p>";
+                if (h.view == v.name && h.stage == sn) o += "<p class=\"hint\"><b>" + esc(h.title) + ":</b> " + esc(h.text) + "</p>";
             o += "<div class=\"scroll\"><table><tr><th>check</th><th>result</th><th>yours</th><th>reference</th>"
                  "<th>details</th></tr>";
             for (const GradeItem &it : g.items) {
@@ -109,7 +144,7 @@ std::string gradeHtml(const KitGrade &g, const Kit &kit) {
             for (const PixelGrade &p : g.images) {
                 if (p.view != v.name || p.stage != sn || p.diffFile.empty()) continue;
                 o += "<figure class=\"diff\"><img src=\"" + esc(p.diffFile) + "\" alt=\"" + esc(sn + " " + p.image) +
-                     " compared with the reference\" width=\"" + std::to_string(std::max(p.width, 320)) + "\"><figcaption>" +
+                     " compared with the reference\" width=\"" + std::to_string(p.diffWidth) + "\"><figcaption>" +
                      esc(sn + " " + p.image) + ": " + pct(p.share()) + " of the pixels agree. Dimmed gray: agrees (the "
                      "reference's depth); blue: edge (the pixel's centre is on a triangle's edge: the fill rule decides "
                      "it); yellow: tie (equal stored depth: the tie rule decides it); red: genuine (another surface, or "

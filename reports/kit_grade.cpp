@@ -32,6 +32,12 @@ std::string fmtDouble(double v) {
     std::snprintf(buf, sizeof buf, "%.17g", v);
     return buf;
 }
+std::string capitalize(std::string s) {
+    if (!s.empty() && s[0] >= 'a' && s[0] <= 'z') s[0] = char(s[0] - 'a' + 'A');
+    return s;
+}
+// The shortest decimal that reads back as v ("0.1", not "0.10000000000000001").
+std::string shortest(double v) { return OJson(v).dump(); }
 std::string percent(double share) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.2f%%", 100 * share);
@@ -170,6 +176,20 @@ bool readAnswers(const std::string &dir, const Kit &kit, AnswerSet *out, std::st
     }
     *out = std::move(set);
     return true;
+}
+
+std::string hintTitle(const std::string &id, PainterKey kitKey) {
+    const std::string own = painterKeyName(kitKey);
+    if (id == "fill_rule") return "Fill rule: the top-left rule inverted";
+    if (id == "tie_rule") return "Ties: LESS_EQUAL instead of LESS";
+    if (id == "depth_test_greater") return "Depth test GREATER: the farthest surface wins";
+    if (id == "near_not_clipped") return "Near plane not clipped";
+    if (id == "winding_reversed") return "Winding reversed";
+    if (id == "painter_key_nearest") return "Painter's key: the nearest vertex instead of the " + own;
+    if (id == "painter_key_farthest") return "Painter's key: the farthest vertex instead of the " + own;
+    if (id == "painter_key_centroid") return "Painter's key: the centroid instead of the " + own;
+    if (id == "painter_front_to_back") return "Painter's order: front to back";
+    return id;
 }
 
 Tolerance kitTolerance(const ToleranceRules &t, const std::string &metric, bool integer) {
@@ -569,7 +589,7 @@ struct Grader {
     void hint(const KitView &v, Stage st, const std::string &id, const std::string &text) {
         for (const GradeHint &h : g.hints)
             if (h.id == id && h.view == v.name && h.stage == stageName(st)) return;
-        g.hints.push_back({id, v.name, stageName(st), text});
+        g.hints.push_back({id, v.name, stageName(st), hintTitle(id, kit.painterKey), text});
     }
     std::string metric(Stage st, const std::string &key) const { return std::string(stageName(st)) + "." + key; }
 
@@ -665,7 +685,7 @@ struct Grader {
         if (front + culled.size() > 0 && 10 * backKept >= 9 * culled.size() && 10 * frontKept <= front &&
             !(missing.empty() && extra.empty()))
             hint(v, Stage::backface, "winding_reversed",
-                 "Winding reversed: you keep " + std::to_string(backKept) + " of the " + std::to_string(culled.size()) +
+                 "You keep " + std::to_string(backKept) + " of the " + std::to_string(culled.size()) +
                      " triangles facing away and cull " + std::to_string(front - frontKept) + " of the " +
                      std::to_string(front) + " facing the eye. Front faces are counter-clockwise seen from the front: "
                      "with n = (v1 − v0) × (v2 − v0), a triangle faces the eye when n·(eye − v0) > 0.");
@@ -753,13 +773,13 @@ struct Grader {
         if (extra) note += "; " + std::to_string(extra) + " for triangles the reference drops";
         if (!first.empty()) note += ". First: " + first;
         item(v, st, "polygons", r, std::to_string(mine.size()) + " polygons", matched == ref.size() && !extra, note);
-        if (nearest < v.cam.nearZ * (1 - 1e-9)) nearPlaneHint(v, "a submitted polygon has a vertex at d = " + fmtDouble(nearest) +
-                                                                   ", nearer than the near plane " + fmtDouble(v.cam.nearZ));
+        if (nearest < v.cam.nearZ * (1 - 1e-9)) nearPlaneHint(v, "a submitted polygon has a vertex at d = " + shortest(nearest) +
+                                                                   ", nearer than the near plane " + shortest(v.cam.nearZ));
     }
 
     void nearPlaneHint(const KitView &v, const std::string &why) {
         hint(v, Stage::clip, "near_not_clipped",
-             "Near plane not clipped: " + why + ". The near plane (d ≥ near) must always be clipped, in clip space "
+             capitalize(why) + ". The near plane (d ≥ near) must always be clipped, in clip space "
              "before the divide, whenever a corner is behind it: a vertex with d < near, and above all one behind "
              "the eye (w ≤ 0), cannot be projected.");
     }
@@ -798,7 +818,7 @@ struct Grader {
             if (key == own || list(o) != s) continue;
             const std::string what = key == "nearest_vertex" ? "its nearest vertex's depth" : key == "farthest_vertex" ? "its farthest vertex's depth" : "its centroid's depth";
             hint(v, st, "painter_key_" + (key == "nearest_vertex" ? std::string("nearest") : key == "farthest_vertex" ? std::string("farthest") : key),
-                 "Painter's key: your order sorts each triangle by " + what + " (" + key + "); this assignment's key "
+                 "Your order sorts each triangle by " + what + " (" + key + "); this assignment's key "
                  "is " + own + (own == "centroid" ? ", the mean (d0 + d1 + d2) / 3 of its three corners' depths" : "") +
                  ". Sort by the key, the largest first; equal keys: the larger id first.");
             return;
@@ -806,7 +826,7 @@ struct Grader {
         std::vector<uint32_t> rev(rv.rbegin(), rv.rend());
         if (s == rev)
             hint(v, st, "painter_front_to_back",
-                 "Drawn front to back: the painter draws the farthest triangle first (the largest key) so that nearer "
+                 "The painter draws the farthest triangle first (the largest key) so that nearer "
                  "ones overwrite it.");
     }
 
@@ -859,22 +879,22 @@ struct Grader {
         if (!bad) return;
         if (pg.edge > 0 && pg.tie == 0 && pg.genuine == 0)
             hint(v, st, "fill_rule",
-                 "Fill rule: every pixel that differs (" + std::to_string(pg.edge) + ") has its centre on an edge, so "
+                 "Every pixel that differs (" + std::to_string(pg.edge) + ") has its centre on an edge, so "
                  "the other triangle got it. This is the pattern of the top-left rule inverted (or of testing E ≥ 0 or "
                  "E > 0 on every edge): a centre exactly on an edge belongs to the triangle only when that edge is a "
                  "left edge (dy < 0) or a top edge (dy = 0, dx > 0).");
         if (pg.tie > 0 && pg.genuine == 0 && st == Stage::zbuffer)
             hint(v, st, "tie_rule",
-                 "Ties: at " + std::to_string(pg.tie) + " pixels another triangle with the same stored depth shows. At "
+                 "At " + std::to_string(pg.tie) + " pixels another triangle with the same stored depth shows. At "
                  "equal stored values the first drawn fragment must win: the test is LESS, not LESS_EQUAL, and "
                  "triangles are drawn in the input's order.");
         if (st == Stage::zbuffer && pg.comparedDepths > 0 && 10 * pg.fartherPixels >= 9 * pg.comparedDepths)
             hint(v, st, "depth_test_greater",
-                 "Depth test: at " + std::to_string(pg.fartherPixels) + " of the " + std::to_string(pg.comparedDepths) +
+                 "At " + std::to_string(pg.fartherPixels) + " of the " + std::to_string(pg.comparedDepths) +
                  " pixels where a wrong surface shows, it is farther than the right one: the farthest surface wins, as "
                  "with a GREATER test. The nearer fragment must win: LESS on the stored value (for a format where "
                  "nearer is larger, the raw values compare the other way round)" +
-                 std::string(depth ? "." : "."));
+                 ".");
     }
 
     void stage(const KitView &v, const StageAnswer &a, const OJson *block) {
@@ -1005,7 +1025,8 @@ OJson kitGradeJson(const KitGrade &g) {
         stages.push_back({{"stage", s.stage}, {"score", s.score}, {"passed", s.passed}, {"total", s.total}});
     j["stages"] = stages;
     OJson hints = OJson::array();
-    for (const GradeHint &h : g.hints) hints.push_back({{"id", h.id}, {"view", h.view}, {"stage", h.stage}, {"text", h.text}});
+    for (const GradeHint &h : g.hints)
+        hints.push_back({{"id", h.id}, {"view", h.view}, {"stage", h.stage}, {"title", h.title}, {"text", h.text}});
     j["hints"] = hints;
     OJson images = OJson::array();
     for (const PixelGrade &p : g.images) {
@@ -1078,10 +1099,23 @@ bool writeGradeImages(KitGrade &g, const std::string &dir, std::string *err) {
         const std::vector<LegendEntry> legend = {{{64, 128, 255}, "edge " + std::to_string(p.edge)},
                                                  {{255, 220, 0}, "tie " + std::to_string(p.tie)},
                                                  {{255, 0, 0}, "genuine " + std::to_string(p.genuine)}};
+        // A small view is enlarged by a whole factor (each pixel a square of them) to at least 256
+        // pixels wide, so its pixels and the legend's counts stay legible.
+        const int k = std::clamp((256 + W - 1) / std::max(W, 1), 1, 8);
+        std::vector<uint8_t> big = img;
+        if (k > 1) {
+            big.assign(size_t(W * k) * size_t(H * k) * 3, 0);
+            for (int y = 0; y < H * k; ++y)
+                for (int x = 0; x < W * k; ++x)
+                    for (int c = 0; c < 3; ++c)
+                        big[(size_t(y) * size_t(W * k) + size_t(x)) * 3 + size_t(c)] =
+                            img[(size_t(y / k) * size_t(W) + size_t(x / k)) * 3 + size_t(c)];
+        }
         int CH = 0;
-        const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);
+        const std::vector<uint8_t> rgb = withLegend(big, W * k, H * k, legend, &CH);
         p.diffFile = p.viewDir + "." + p.stage + "." + p.image + ".diff.png";
-        if (!writePngRgb8((fs::path(dir) / p.diffFile).string(), W, CH, rgb.data(), err)) return false;
+        p.diffWidth = W * k;
+        if (!writePngRgb8((fs::path(dir) / p.diffFile).string(), W * k, CH, rgb.data(), err)) return false;
         std::vector<uint8_t>().swap(p.cls);
         std::vector<uint8_t>().swap(p.gray);
     }

@@ -43,6 +43,7 @@ struct PixelGrade {
     uint64_t fartherPixels = 0;   // of genuine with both a reference and a submitted surface: the
     uint64_t comparedDepths = 0;  //   submitted one is farther (fartherPixels) of comparedDepths
     std::string diffFile;         // the diff image's file name (set when written)
+    int diffWidth = 0;            // its width: the view's, enlarged by a whole factor when small
     double share() const { return pixels ? double(agree) / double(pixels) : 0; }
 };
 
@@ -51,8 +52,11 @@ struct GradeHint {
     std::string id;    // fill_rule, tie_rule, depth_test_greater, near_not_clipped, winding_reversed,
                        // painter_key_nearest, painter_key_farthest, painter_front_to_back
     std::string view, stage;
-    std::string text;  // what the pattern is and what to check
+    std::string title;  // the mistake in a few words ("Fill rule: the top-left rule inverted")
+    std::string text;   // what the pattern is, with this view's numbers, and what to check
 };
+// A hint's title (the painter's hints name the kit's key).
+std::string hintTitle(const std::string &id, PainterKey kitKey);
 
 struct StageScore {
     std::string stage;
@@ -91,7 +95,8 @@ nlohmann::ordered_json kitGradeJson(const KitGrade &g);
 // the score.
 std::string kitGradeTable(const KitGrade &g);
 // Writes each image's diff picture (VIEWDIR.STAGE.IMAGE.diff.png: the reference's depth dimmed,
-// disagreeing pixels colored by class, a legend with the counts) into dir; sets diffFile.
+// disagreeing pixels colored by class, a legend with the counts; a view under 256 pixels wide
+// enlarged by a whole factor) into dir; sets diffFile and diffWidth.
 bool writeGradeImages(KitGrade &g, const std::string &dir, std::string *err);
 // grade.html: self-contained (inline CSS, the diff PNGs next to it), as report.html is.
 std::string gradeHtml(const KitGrade &g, const Kit &kit);

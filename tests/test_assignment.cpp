@@ -453,17 +453,6 @@ size_t itemsOf(const kit::KitGrade &g, const std::string &stage) {
     for (const GradeItem &it : g.items) n += it.stage == stage;
     return n;
 }
-// The score when `failed[s]` checks of stage s fail: the mean over the four stages of passed / total.
-double expectedScore(const kit::KitGrade &g, const std::map<std::string, size_t> &failed) {
-    double sum = 0;
-    for (const char *s : {"backface", "clip", "zbuffer", "painter"}) {
-        const double total = double(itemsOf(g, s));
-        const auto it = failed.find(s);
-        sum += (total - double(it == failed.end() ? 0 : it->second)) / total;
-    }
-    return sum / 4;
-}
-
 class Assignment : public testing_util::TempDirTest {
   protected:
     Assignment() : TempDirTest("assignment") {}
@@ -724,7 +713,9 @@ TEST_F(BadSubmission, AViewThatIsNotAnObjectFailsThatViewOnly) {
     EXPECT_EQ(g.failed, 48u);  // every check of spawn; top passes
     for (const GradeItem &it : g.items) {
         EXPECT_EQ(it.pass, it.view == "top") << it.view << " " << it.key;
-        if (it.view == "spawn") EXPECT_EQ(it.note, "views.spawn is not an object");
+        if (it.view == "spawn") {
+            EXPECT_EQ(it.note, "views.spawn is not an object");
+        }
     }
 }
 
@@ -793,9 +784,13 @@ class AssignmentCli : public testing_util::TempDirTest {
     AssignmentCli() : TempDirTest("assignment-cli") {}
     testing_util::ChildResult run(const std::vector<std::string> &args) { return testing_util::runBinary(args, dir_); }
     std::string file(const fs::path &p) { return testing_util::slurpFile(p); }
-    // The demo's kit at 96 x 54 (its views spawn and overview), by the command.
+    // The demo's kit for kitViews() (a views file), by the command; `extra` replaces the views.
     void makeKit(const std::string &name = "kit", const std::vector<std::string> &extra = {}) {
-        std::vector<std::string> args = {"assignment", "--width", "96", "--height", "54", "--out", (dir_ / name).string(), "--quiet"};
+        json views = json::array();
+        for (const ViewSpec &v : kitViews()) views.push_back(json::parse(kit::viewSpecJson(v).dump()));
+        std::ofstream(dir_ / "views.json") << json{{"views", views}}.dump();
+        std::vector<std::string> args = {"assignment", "--out", (dir_ / name).string(), "--quiet"};
+        if (extra.empty()) args.insert(args.end(), {"--views", (dir_ / "views.json").string()});
         args.insert(args.end(), extra.begin(), extra.end());
         const testing_util::ChildResult r = run(args);
         ASSERT_EQ(r.code, 0) << r.err;
@@ -805,14 +800,16 @@ class AssignmentCli : public testing_util::TempDirTest {
 TEST_F(AssignmentCli, KitAndAnswersAreWrittenApart) {
     makeKit();
     for (const char *f : {"assignment.json", "README.md", "CONVENTIONS.md", "scene.obj", "views.json",
-                          "template/submission.json", "views/spawn/clip.json", "views/overview/painter.json"})
+                          "template/submission.json", "views/spawn/clip.json", "views/top/painter.json"})
         EXPECT_TRUE(fs::is_regular_file(dir_ / "kit" / f)) << f;
-    for (const char *f : {"answers.json", "views/spawn/zbuffer.json", "views/spawn/zbuffer.ids.exr", "views/overview/painter.ids.exr"})
+    for (const char *f : {"answers.json", "views/spawn/zbuffer.json", "views/spawn/zbuffer.ids.exr", "views/top/painter.ids.exr"})
         EXPECT_TRUE(fs::is_regular_file(dir_ / "kit-answers" / f)) << f;
     // Nothing of the answers in the students' kit.
     for (const auto &e : fs::recursive_directory_iterator(dir_ / "kit")) {
         EXPECT_NE(e.path().extension(), ".exr") << e.path();
-        if (e.is_regular_file()) EXPECT_EQ(file(e.path()).find("visaudit-answer"), std::string::npos) << e.path();
+        if (e.is_regular_file()) {
+            EXPECT_EQ(file(e.path()).find("visaudit-answer"), std::string::npos) << e.path();
+        }
     }
     // The OBJ has one face per triangle id; views.json loads as a views file.
     const std::string obj = file(dir_ / "kit" / "scene.obj");
@@ -912,10 +909,13 @@ TEST_F(AssignmentCli, RefusesBadInstructorInputWithExit2) {
         << r.err;
 }
 
+// VISAUDIT_GRADE_PAGE=DIR keeps a copy of the grade folder there (docs/images/grade-html.png is a
+// screenshot of its grade.html).
 TEST_F(AssignmentCli, OneSubmissionGetsItsPageAndExit1OnAFailure) {
     makeKit();
     Mistakes m;
     m.invertFill = true;
+    m.skipNear = true;
     writeSubmission(dir_ / "kit", dir_ / "erin", m);
     const testing_util::ChildResult r = run({"grade", "--kit", (dir_ / "kit").string(), "--reference",
                                              (dir_ / "kit-answers").string(), "--submission", (dir_ / "erin").string(),
@@ -925,6 +925,11 @@ TEST_F(AssignmentCli, OneSubmissionGetsItsPageAndExit1OnAFailure) {
     const std::string html = file(dir_ / "grade" / "grade.html");
     EXPECT_NE(html.find("<h1>Grade: erin</h1>"), std::string::npos);
     EXPECT_NE(html.find("top-left rule inverted"), std::string::npos);
+    EXPECT_NE(html.find("Near plane not clipped"), std::string::npos);
+    if (const char *keep = std::getenv("VISAUDIT_GRADE_PAGE")) {
+        fs::remove_all(keep);
+        fs::copy(dir_ / "grade", keep, fs::copy_options::recursive);
+    }
     // Every image the page shows is a file next to it.
     for (size_t at = html.find("<img src=\""); at != std::string::npos; at = html.find("<img src=\"", at + 1)) {
         const size_t b = at + 10, e = html.find('"', b);
