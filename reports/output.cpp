@@ -72,6 +72,9 @@ bool replaceable(const std::string &dir, std::string *why) {
     if (fs::is_regular_file(fs::path(dir) / "report.json", ec)) return true;
     if (fs::is_regular_file(fs::path(dir) / "pvs-audit.json", ec)) return true;
     if (fs::is_regular_file(fs::path(dir) / "diff.json", ec)) return true;  // visaudit diff's folder
+    // An assignment kit, its answers, a student's grade, a class's grades.
+    for (const char *marker : {"assignment.json", "answers.json", "grade.json", "grades.csv"})
+        if (fs::is_regular_file(fs::path(dir) / marker, ec)) return true;
     *why = "refusing to replace '" + dir +
            "': it is not empty and holds no report.json, so it is not a visaudit report folder; "
            "choose another --out folder (or an empty one)";

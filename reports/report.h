@@ -191,7 +191,8 @@ bool writeExrUint32(const std::string &path, int width, int height, const uint32
 
 // An output directory written as a whole or not at all: files go into a staging folder next to
 // the target, and commit() swaps it in. An existing target is replaced only if it is a visaudit
-// report folder (holds report.json) or empty; anything else is refused, never deleted.
+// folder (holds report.json, pvs-audit.json, an assignment kit's assignment.json or answers.json, a
+// grade's grade.json or grades.csv) or empty; anything else is refused, never deleted.
 class OutputDir {
   public:
     OutputDir() = default;

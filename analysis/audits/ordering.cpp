@@ -161,20 +161,30 @@ const char *painterKeyName(PainterKey k) {
     return "?";
 }
 
-std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
+std::vector<PainterCandidate> painterCandidates(const OrderingView &v) {
     const Scene &scene = *v.scene;
-    std::vector<std::pair<double, uint32_t>> keyed;
+    std::vector<PainterCandidate> out;
     for (uint32_t s = 0; s < scene.triangleCount(); ++s) {
         if (v.screenEnd[s] == v.screenBegin[s]) continue;
-        const double d0 = viewDepth(v.cam, vertexOf(scene, s, 0)), d1 = viewDepth(v.cam, vertexOf(scene, s, 1)),
-                     d2 = viewDepth(v.cam, vertexOf(scene, s, 2));
+        out.push_back({s,
+                       {viewDepth(v.cam, vertexOf(scene, s, 0)), viewDepth(v.cam, vertexOf(scene, s, 1)),
+                        viewDepth(v.cam, vertexOf(scene, s, 2))}});
+    }
+    return out;
+}
+
+std::vector<uint32_t> painterOrder(const std::vector<PainterCandidate> &candidates, PainterKey key) {
+    std::vector<std::pair<double, uint32_t>> keyed;
+    keyed.reserve(candidates.size());
+    for (const PainterCandidate &c : candidates) {
+        const double d0 = c.depth[0], d1 = c.depth[1], d2 = c.depth[2];
         double k = 0;
         switch (key) {
             case PainterKey::centroid: k = (d0 + d1 + d2) / 3; break;  // depth is affine: the centroid's depth
             case PainterKey::nearestVertex: k = std::min(d0, std::min(d1, d2)); break;
             case PainterKey::farthestVertex: k = std::max(d0, std::max(d1, d2)); break;
         }
-        keyed.push_back({k, s});
+        keyed.push_back({k, c.source});
     }
     // Back to front: largest key first; equal keys by descending id, so the lowest id is drawn
     // last and shows (the reference's tie rule).
@@ -184,6 +194,10 @@ std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
     std::vector<uint32_t> order(keyed.size());
     for (size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
     return order;
+}
+
+std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
+    return painterOrder(painterCandidates(v), key);
 }
 
 namespace {
