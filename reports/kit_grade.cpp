@@ -210,6 +210,22 @@ Tolerance kitTolerance(const ToleranceRules &t, const std::string &metric, bool 
 
 namespace {
 
+// Whether `path`, its links followed, lies inside `dir` (followed too): a submission's files are read
+// only there, so a link cannot make the grader read, and quote in a message, someone else's file.
+bool withinFolder(const fs::path &path, const fs::path &dir) {
+    std::error_code ec;
+    const fs::path d = fs::weakly_canonical(dir, ec);
+    if (ec) return false;
+    const fs::path p = fs::weakly_canonical(path, ec);
+    if (ec) return false;
+    auto pi = p.begin();
+    for (auto di = d.begin(); di != d.end(); ++di, ++pi) {
+        if (di->empty()) continue;  // a trailing separator
+        if (pi == p.end() || *pi != *di) return false;
+    }
+    return true;
+}
+
 // ---- Student images ---------------------------------------------------------------------------------
 
 struct Pixels {
@@ -848,10 +864,10 @@ struct Grader {
         // A file of the submission folder (or below it): the grader reads nothing else.
         bool inside = !fs::path(file).is_absolute();
         for (const fs::path &part : fs::path(file)) inside = inside && part != "..";
-        if (!inside)
+        const fs::path path = fs::path(subDir) / file;
+        if (!inside || !withinFolder(path, subDir))
             return item(v, st, key, r, "unreadable", false,
                         "'" + file + "' is not a file of the submission folder; name the image relative to it");
-        const fs::path path = fs::path(subDir) / file;
         Pixels px;
         std::string why;
         const bool depth = which == "depth";
@@ -970,6 +986,8 @@ KitGrade gradeSubmission(const Kit &kit, const AnswerSet &answers, const Toleran
     std::string err;
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) g.error = dir + ": not a folder (a submission is a folder holding submission.json)";
+    else if (fs::exists(file, ec) && !withinFolder(file, dir))
+        g.error = file + ": a link to a file outside the submission folder; hand in the file itself";
     else if (!json::parseFile(file, &doc, &err, maxJsonDepth)) g.error = err;
     else if (!doc.root.is_object() || !doc.root.contains("format") || doc.root["format"] != kSubmissionFormat)
         g.error = json::where(doc, json::Path{} / "format") + ": \"format\" must be \"" + kSubmissionFormat +

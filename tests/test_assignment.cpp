@@ -697,7 +697,12 @@ TEST_F(BadSubmission, UnreadableSubmissionsFailEveryCheckWithTheReason) {
     std::ofstream(dir_ / "shape" / "submission.json") << R"({"format": "visaudit-submission/1", "views": []})";
     const kit::KitGrade shape = grade(dir_ / "shape");
     EXPECT_NE(shape.error.find("expected \"views\": {\"VIEW\": {...}}"), std::string::npos) << shape.error;
-    for (const kit::KitGrade *g : {&none, &empty, &syntax, &shape}) {
+    fs::create_directories(dir_ / "link");
+    fs::create_symlink(dir_ / "syntax" / "submission.json", dir_ / "link" / "submission.json");
+    const kit::KitGrade link = grade(dir_ / "link");
+    EXPECT_NE(link.error.find("submission.json: a link to a file outside the submission folder"), std::string::npos)
+        << link.error;
+    for (const kit::KitGrade *g : {&none, &empty, &syntax, &shape, &link}) {
         EXPECT_EQ(g->score, 0.0);
         EXPECT_EQ(g->passed, 0u);
         EXPECT_EQ(g->failed, 96u);
@@ -740,12 +745,14 @@ TEST_F(BadSubmission, BadImagesAndListsAreNamedFailures) {
         for (int y = 0; y < 64; ++y)
             for (int x = 0; x < 64; ++x) csv << (x == 3 && y == 2 ? "2.5" : "0") << (x == 63 ? "\n" : ",");
     }
+    fs::create_symlink(dir_ / "good" / "spawn.depth.pfm", d / "link.pfm");  // a link out of the folder
     edit(d, [](json &j) {
         j["views"]["spawn"]["zbuffer"]["ids"] = "small.png";
         j["views"]["spawn"]["painter"]["ids"] = "rgb.png";
         j["views"]["top"]["zbuffer"]["depth"] = "nan.pfm";
         j["views"]["top"]["zbuffer"]["ids"] = "half.csv";
         j["views"]["top"]["painter"]["ids"] = "../good/top.painter.png";
+        j["views"]["spawn"]["zbuffer"]["depth"] = "link.pfm";
         j["views"]["spawn"]["backface"]["kept"] = "abc";
         j["views"]["spawn"]["clip"]["polygons"][0] = json{{"id", 1}};
         j["views"]["top"]["zbuffer"]["histogram"] = json::array({1, "two"});
@@ -758,6 +765,7 @@ TEST_F(BadSubmission, BadImagesAndListsAreNamedFailures) {
         {{"top", "zbuffer.depth"}, "nan.pfm: NaN at pixel (7, 5); write +inf or 0 for background"},
         {{"top", "zbuffer.ids"}, "half.csv: 2.5 at pixel (3, 2) is not an id (1 + a triangle id, 0 for background)"},
         {{"top", "painter.ids"}, "'../good/top.painter.png' is not a file of the submission folder; name the image relative to it"},
+        {{"spawn", "zbuffer.depth"}, "'link.pfm' is not a file of the submission folder; name the image relative to it"},
         {{"spawn", "backface.kept"}, "not an array of ids: \"abc\""},
         {{"spawn", "clip.polygons"}, "polygons[0]: expected {\"id\": ID, \"vertices\": [[x, y, w, d], ...]}"},
         {{"top", "zbuffer.histogram"}, "not every entry is a number"},
