@@ -19,6 +19,8 @@
 #include "analysis/stages/portals.h"
 #include "analysis/audits/pvs_evidence.h"
 #include "analysis/effects_plan.h"
+#include "analysis/level_map.h"
+#include "analysis/load/route.h"
 #include "analysis/scene.h"
 #include "analysis/audits/zfight.h"
 #include "render/clip.h"
@@ -206,6 +208,12 @@ struct AnalysisResult {
         size_t viewsTotal = 0;        // views before the selection
     } shard;
     std::vector<ViewResult> views;
+    // The routes the views were sampled from (--views route:FILE): their definitions; the frames
+    // are views whose spec.route names the route (docs/routes.md).
+    std::vector<Route> routes;
+    // The level's floor plan when the run draws level maps (--level-maps; docs/level-maps.md): the
+    // report's level_maps are the views' positions over it.
+    std::optional<FloorPlan> floorPlan;
     // Depth resolution against view depth per format, one set per distinct (near, far, formats), in
     // the order the views first use them (ViewResult::depthCurve); computed once per set.
     std::vector<DepthAuditResult> depthCurves;

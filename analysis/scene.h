@@ -30,11 +30,20 @@ struct Light {
     Vec3 position;             // point
 };
 
+// A view that is a frame of a route (analysis/load/route.h): which route, which frame, when.
+struct RouteStop {
+    std::string route;      // the route's name; empty: the view is on no route
+    uint32_t frame = 0;     // 0-based, in the route's order
+    double time = 0;        // seconds on the route's timeline
+    bool onRoute() const { return !route.empty(); }
+};
+
 struct ViewSpec {
     std::string name;
     CameraSpec camera;
     DepthFormatSpec depthFormat = DepthFormat::f32;
-    std::string origin;  // where it came from: "scene", a views file, "orbit:N", "gltf camera"
+    std::string origin;  // where it came from: "scene", a views file, "orbit:N", "gltf camera", "route:FILE"
+    RouteStop route;     // a route's frame (route:FILE); empty otherwise
 };
 
 // What a mesh file held, as read: every face kept, polygons fan-triangulated.

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/level_map.h"
 #include "analysis/pipeline.h"
 #include "cli/cmd_pvs_audit.h"
 #include "cli/command_table.h"
@@ -23,8 +24,10 @@
 #include "reports/budget.h"
 #include "reports/console.h"
 #include "reports/html.h"
+#include "reports/level_maps.h"
 #include "reports/merge.h"
 #include "reports/report.h"
+#include "reports/routes.h"
 #include "render/stopwatch.h"
 
 namespace va {
@@ -32,6 +35,8 @@ namespace {
 
 struct AnalyzeOptions : SceneOptions {
     std::string images = "all";  // --images all|key|none
+    std::string levelMaps = "auto";  // --level-maps auto|on|off
+    int mapSize = 768;               // --map-size
     std::string out = "visaudit-report";
     std::string depthFormat;
     int width = 0, height = 0;
@@ -77,6 +82,17 @@ bool memoryLimit(const AnalyzeOptions &o, uint64_t *bytes) {
     return true;
 }
 
+
+// Whether the run draws level maps: "on", "off", or "auto": when every view is a level sample
+// (walk:N, grid:N, clusters), the view sets made to cover a level.
+bool wantLevelMaps(const std::string &mode, const std::vector<ViewSpec> &views) {
+    if (mode == "on") return !views.empty();
+    if (mode == "off" || views.empty()) return false;
+    for (const ViewSpec &v : views)
+        if (v.origin.rfind("walk:", 0) != 0 && v.origin.rfind("grid:", 0) != 0 && v.origin.rfind("clusters", 0) != 0)
+            return false;
+    return true;
+}
 
 bool makeSettings(const AnalyzeOptions &o, PipelineSettings *s) {
     s->frustum = !o.noFrustum;
@@ -149,9 +165,11 @@ int analyzeToReport(const AnalyzeOptions &o,
     if (!makeSettings(o, &settings)) return kExitBadInput;
     Scene scene;
     std::vector<ViewSpec> views;
-    if (!loadInputs(o, &scene, &views)) return kExitBadInput;
+    std::vector<Route> routes;
+    if (!loadInputs(o, &scene, &views, &routes)) return kExitBadInput;
     if (interrupted()) return interruptedExit(o.out);
     const double loadMs = loadTime.ms();
+    const bool levelMaps = wantLevelMaps(o.levelMaps, views);  // decided on every view, before --shard
 
     std::string err;
     // Image names are fixed over the full view list before any selection or parallel run, so
@@ -159,6 +177,7 @@ int analyzeToReport(const AnalyzeOptions &o,
     const std::vector<std::string> allBases = imageBaseNames(views);
     AnalysisResult result;
     result.shard.viewsTotal = views.size();
+    result.routes = std::move(routes);
     std::vector<size_t> indices;  // positions in the full list of the views this run analyses
     if (!o.shard.empty()) {
         if (!parseShard(o.shard, &result.shard.index, &result.shard.count, &err)) {
@@ -177,6 +196,19 @@ int analyzeToReport(const AnalyzeOptions &o,
         bases.push_back(allBases[i]);
     }
     views = std::move(selected);
+    // Level maps (docs/level-maps.md): for views that cover the level (walk:N, grid:N, clusters), or
+    // any views with --level-maps on. The floor plan is rendered once, before the views.
+    if (levelMaps) {
+        FloorPlanSettings fs;
+        fs.size = o.mapSize;
+        fs.eyeHeight = o.eyeHeight;
+        FloorPlan plan;
+        if (!renderFloorPlan(scene, fs, &plan, &err)) {
+            fail(err + " (--level-maps)");
+            return kExitBadInput;
+        }
+        result.floorPlan = std::move(plan);
+    }
     if (beforeRun && !beforeRun(views, &settings, &err)) {
         fail(err);
         return kExitBadInput;
@@ -231,6 +263,16 @@ int analyzeToReport(const AnalyzeOptions &o,
     const Stopwatch r0;
     *report = reportJson(result, imageSet);
     outputMs.reportMs = r0.ms();
+    // A route's plot (route-NAME.png) and the level maps are images like the views' ones: written
+    // unless --images none.
+    if (imageSet != ImageSet::none) {
+        if (!writeRoutePlots(report, out.staging(), &err) ||
+            (result.floorPlan && (!writeFloorPlanPng(*result.floorPlan, out.staging(), &err) ||
+                                  !writeLevelMapImages(report, out.staging(), &err)))) {
+            fail(err);
+            return kExitBadInput;
+        }
+    }
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was. A signal is honoured up to the
     // commit; the swap itself is not interrupted (the handler only sets a flag), and a run whose
@@ -377,6 +419,12 @@ void addAnalyzeOptions(CLI::App *c, AnalyzeOptions &o) {
                   "Images written: all (default), key (per view the depth, overdraw, z-fighting and culling PNGs the "
                   "page shows first), none (numbers only: report.json and report.html)")
         ->check(CLI::IsMember({"all", "key", "none"}));
+    c->add_option("--level-maps", o.levelMaps,
+                  "Top-down level maps of triangles drawn, overdraw, wasted draws and false culls per position: auto "
+                  "(default: for walk:N, grid:N and clusters), on (any views), off")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
+    c->add_option("--map-size", o.mapSize, "Level maps: pixels along the level's longer side (default 768)")
+        ->check(CLI::Range(16, 8192));
     c->add_option("--width", o.width, "Override every view's width in pixels")->check(CLI::Range(1, 1 << 30));
     c->add_option("--height", o.height, "Override every view's height in pixels")->check(CLI::Range(1, 1 << 30));
     c->add_option("--depth-format", o.depthFormat,

@@ -15,6 +15,7 @@ CommandRun setupCheck(CLI::App *c);       // cli/cmd_analyze.cpp
 CommandRun setupGrade(CLI::App *c);       // cli/cmd_grade.cpp
 CommandRun setupAssignment(CLI::App *c);  // cli/cmd_assignment.cpp
 CommandRun setupMerge(CLI::App *c);       // cli/cmd_merge.cpp
+CommandRun setupDiff(CLI::App *c);        // cli/cmd_diff.cpp
 CommandRun setupDepthAudit(CLI::App *c);  // cli/cmd_depth_audit.cpp
 CommandRun setupPvsAudit(CLI::App *c);    // cli/cmd_pvs_audit.cpp
 

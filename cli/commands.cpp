@@ -37,6 +37,9 @@ const Command kCommands[] = {
                    "and its reference answers",
      setupAssignment},
     {"merge", "Join the reports of analyze --shard K/N runs into one report", setupMerge},
+    {"diff", "Compare two runs: per view and route frame the metric deltas, the level maps of the change, image "
+             "diffs; exit 1 when a regression exceeds the budget",
+     setupDiff},
     {"depth-audit", "Per depth format: resolution against distance, distinct values, from where 1 cm / 1 mm can fight",
      setupDepthAudit},
     {"pvs-audit", "Audit every cluster of a Quake 3 map's PVS: clusters seen yet hidden (misses), visible yet never seen "

@@ -47,7 +47,7 @@ int interruptedExit(const std::string &out) {
 }
 
 
-bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *views) {
+bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *views, std::vector<Route> *routes) {
     std::string err;
     if (o.scene.empty()) {
         *scene = demoScene();
@@ -80,11 +80,19 @@ bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *view
     // Whatever a loader dropped or ignored is said, even with --quiet (it changes what is analysed).
     for (const std::string &w : scene->warnings) std::fprintf(stderr, "visaudit: warning: %s\n", w.c_str());
     bool handled = false;
-    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err)) {
+    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err, o.eyeHeight)) {
         fail(err);
         return false;
     }
-    if (handled) {
+    Route route;
+    if (!handled && !o.views.empty() && !routeViewsFromSpec(o.views, *scene, o.maxJsonDepth, views, &route, &handled, &err)) {
+        fail(err);
+        return false;
+    }
+    if (handled && !route.keyframes.empty()) {
+        // route:FILE: its frames
+        if (routes) routes->push_back(std::move(route));
+    } else if (handled) {
         // spawns, walk:N: the map's own views
     } else if (o.views.empty()) {
         *views = scene->views;
@@ -162,8 +170,14 @@ void addJsonDepthOption(CLI::App *c, uint64_t &maxJsonDepth) {
 void addSceneOptions(CLI::App *c, SceneOptions &o) {
     c->add_option("scene", o.scene, "Scene file: .json (visaudit-scene/1), .obj .ply .off .stl, .gltf .glb; "
                                     "none = the built-in demo");
-    c->add_option("--views", o.views, "Views: a views file (.json); orbit:N (N cameras around the scene); for a "
-                                      "Quake 3 map, spawns (its spawn points) or walk:N[:SEED] (N points inside its clusters)");
+    c->add_option("--views", o.views, "Views: a views file (.json); orbit:N (N cameras around the scene); "
+                                      "route:FILE[:N|:Ts] (a route file's keyframes, N frames, or a frame every T "
+                                      "seconds); grid:N[:D] (N positions over the floor plan, D directions each); for a "
+                                      "Quake 3 map, spawns (its spawn points), walk:N[:SEED] (N points inside its "
+                                      "clusters) or clusters[:D] (one position per cluster)");
+    c->add_option("--eye-height", o.eyeHeight,
+                  "grid:N: the eye's height above the floor (default 50 on a Quake 3 map, else 1.7)")
+        ->check(CLI::Range(0.0, 1e30));
     c->add_option("--patch-level", o.patchLevel, "Quake 3 maps: segments per Bezier patch edge")->check(CLI::Range(1, 64));
     c->add_option("--chunk", o.chunk, "Split meshes into culling objects of at most this many triangles")
         ->check(CLI::Range(1u, 1u << 30));

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "analysis/load/route.h"
 #include "analysis/scene.h"
 #include "common/limits.h"
 #include "render/depth_format.h"
@@ -32,18 +33,21 @@ int interruptedExit(const std::string &out);
 // The scene and its views: every command that loads a scene has these flags.
 struct SceneOptions {
     std::string scene;          // empty: the built-in demo
-    std::string views;          // views file, "orbit:N", "spawns", "walk:N", or empty (the scene's own)
+    std::string views;          // views file, "orbit:N", "spawns", "walk:N", "route:FILE[:N|:Ts]", or empty (the scene's own)
     int patchLevel = 5;
     uint32_t chunk = 512;
     uint64_t maxTriangles = kDefaultMaxTriangles;
     uint64_t maxJsonDepth = kDefaultMaxJsonDepth;
     bool refuseEmptyScene = false;  // check: a scene with no triangle is exit 2, not an empty pass
+    double eyeHeight = 0;           // grid:N's eyes above the floor (0: 50 on a Quake 3 map, else 1.7)
 };
 void addSceneOptions(CLI::App *c, SceneOptions &o);
 // --max-json-depth: every command that reads JSON (docs/limits.md, "JSON nesting").
 void addJsonDepthOption(CLI::App *c, uint64_t &maxJsonDepth);
 // Loads the scene (or makes the demo) and its views as the options say; false after saying why.
-bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *views);
+// `routes` (optional) receives the route the views were sampled from (--views route:FILE).
+bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *views,
+                std::vector<Route> *routes = nullptr);
 
 // "a,b,log24:C=0.01" or "all" into depth formats (in the order given); false + message on an
 // unknown or repeated name.

@@ -223,7 +223,7 @@ std::vector<DepthFormatSpec> budgetDepthFormats(const Budget &budget) {
 }
 
 bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *baseline, BudgetResult *out,
-                    std::string *err) {
+                    std::string *err, const BudgetEvaluation &how) {
     BudgetResult r;
     if (baseline) {
         if (!baseline->contains("format") || (*baseline)["format"] != report["format"]) {
@@ -232,21 +232,34 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
             return false;
         }
         if ((*baseline)["scene"]["path"] != report["scene"]["path"] ||
-            (*baseline)["scene"]["source_triangles"] != report["scene"]["source_triangles"]) {
+            (how.sameTriangles && (*baseline)["scene"]["source_triangles"] != report["scene"]["source_triangles"])) {
             *err = "the baseline is a report of another scene (" + (*baseline)["scene"]["path"].get<std::string>() +
                    ", " + std::to_string((*baseline)["scene"]["source_triangles"].get<uint64_t>()) +
                    " triangles); give the baseline of " + report["scene"]["path"].get<std::string>();
             return false;
         }
     }
+    std::map<std::string, std::string> frames;  // view name -> its frame of a route
     for (const OJson &view : report["views"]) {
         const std::string name = view["name"];
+        // A route's frame (docs/routes.md): its checks say which frame of which route, and when.
+        std::string frame;
+        if (view.contains("route") && view["route"].is_object()) {
+            const OJson &rt = view["route"];
+            frame = "frame " + (rt["frame"].is_number() ? fmt(rt["frame"].get<double>()) : std::string("?")) +
+                    " of route '" + (rt["name"].is_string() ? rt["name"].get<std::string>() : std::string()) + "' at " +
+                    (rt["time"].is_number() ? fmt(rt["time"].get<double>()) : std::string("?")) + " s";
+        }
+        if (!frame.empty()) frames[name] = frame;
         // Limits: the scene-wide ones, overridden per view; false_culls defaults to 0 where the
         // report has the audit.
-        std::map<std::string, nlohmann::json> limits = budget.limits;
-        if (auto it = budget.views.find(name); it != budget.views.end())
-            for (const auto &[k, v] : it->second) limits[k] = v;
-        if (!limits.count("false_culls") && metricValue("false_culls", view)) limits["false_culls"] = 0;
+        std::map<std::string, nlohmann::json> limits;
+        if (how.limits) {
+            limits = budget.limits;
+            if (auto it = budget.views.find(name); it != budget.views.end())
+                for (const auto &[k, v] : it->second) limits[k] = v;
+            if (!limits.count("false_culls") && metricValue("false_culls", view)) limits["false_culls"] = 0;
+        }
 
         for (const BudgetMetric &m : budgetMetrics()) {
             auto lim = limits.find(m.name);
@@ -340,6 +353,11 @@ bool evaluateBudget(const Budget &budget, const OJson &report, const OJson *base
             r.checks.push_back(c);
         }
     }
+    for (BudgetCheck &c : r.checks)
+        if (auto it = frames.find(c.view); it != frames.end()) {
+            c.frame = it->second;
+            if (!c.message.empty()) c.message += " (" + c.frame + ")";
+        }
     for (const BudgetCheck &c : r.checks) r.failed += !c.pass;
     *out = std::move(r);
     return true;
@@ -460,7 +478,7 @@ std::string budgetJUnit(const BudgetResult &r, const std::string &suite) {
       << r.failed << "\" errors=\"0\" skipped=\"0\">\n";
     for (const BudgetCheck &c : r.checks) {
         s << "    <testcase classname=\"" << xmlEscape(suite + "." + c.view) << "\" name=\""
-          << xmlEscape(c.kind + " " + c.metric) << "\"";
+          << xmlEscape(c.kind + " " + c.metric + (c.frame.empty() ? "" : ", " + c.frame)) << "\"";
         if (c.pass) {
             s << "/>\n";
         } else {

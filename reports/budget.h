@@ -52,16 +52,25 @@ struct BudgetCheck {
     std::string allowed;     // the limit (formatted)
     bool pass = true;
     std::string message;     // e.g. "overdraw in view 'atrium' rose 23%, allowed 10%"
+    std::string frame;       // a route's frame: "frame 12 of route 'atrium-run' at 1.5 s" (else empty)
 };
 struct BudgetResult {
     std::vector<BudgetCheck> checks;  // views in report order, metrics in budgetMetrics() order
     size_t failed = 0;
 };
 
+// What evaluateBudget checks: `limits` (check: the limits and the regressions; diff: the
+// regressions only), and whether a baseline must be of the same geometry (check: same scene path
+// and source triangles; diff compares two versions of one level: the same scene path).
+struct BudgetEvaluation {
+    bool limits = true;
+    bool sameTriangles = true;
+};
 // Checks the report (and, with a baseline report, the regressions). False + message when the
 // report lacks what a budget needs, or the baseline is of another scene or report format.
 bool evaluateBudget(const Budget &budget, const nlohmann::ordered_json &report,
-                    const nlohmann::ordered_json *baseline, BudgetResult *out, std::string *err);
+                    const nlohmann::ordered_json *baseline, BudgetResult *out, std::string *err,
+                    const BudgetEvaluation &how = {});
 
 // Whether the budget names a map-wide metric (pvs_*): `check` then runs the PVS audit too.
 bool budgetNeedsPvsAudit(const Budget &budget);
@@ -74,7 +83,8 @@ bool evaluatePvsBudget(const Budget &budget, const nlohmann::ordered_json &pvsAu
 
 // A console table of every check (failures first), and the summary line.
 std::string budgetTable(const BudgetResult &r);
-// JUnit XML: one test suite, one test case per view and budget, failures with their message.
+// JUnit XML: one test suite, one test case per view and budget, failures with their message; a
+// route's frame names the frame and its time in the test case's name.
 std::string budgetJUnit(const BudgetResult &r, const std::string &suiteName);
 
 }  // namespace va

@@ -223,6 +223,8 @@ std::string reportHtml(const nlohmann::ordered_json &reportIn, const std::string
          "<title>visaudit: " + esc(scenePath) + "</title><style>" + html_assets::kCss + "</style></head><body>\n";
     w.header();
     w.summary();
+    w.routes();
+    w.levelMaps();
     w.planner();
     w.quakeMap();
     if (const Json *scene = get(&report, "scene"))

@@ -6,6 +6,7 @@
 //   html_charts.cpp   inline SVG: the stage funnel, the accuracy scatter, depth resolution curves
 //   html_images.cpp   the image files next to the page (kImageKinds) and highlight boxes over them
 //   html_markup.cpp   escaping, value formatting and the generic tables any section falls back to
+//   html_routes.cpp   the routes' plots and the level maps (only in reports that have them)
 // The page presents the report's numbers and its findings (reports/findings.h); it computes
 // neither. Everything reads the report through reports/report_read.h, which never throws.
 #pragma once
@@ -121,6 +122,8 @@ struct HtmlWriter {
     void quakeMap();
     void depthAuditImage();
     void pvsAuditLink();
+    void routes();     // html_routes.cpp: each route's series as a plot, worst frames linked
+    void levelMaps();  // html_routes.cpp: the level maps, worst positions linked
     void view(const Json *v, size_t pos);
     void answers(const Json *v);
     // eager: load with the page (the first views); else lazily, when scrolled near (reports of

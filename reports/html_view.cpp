@@ -490,6 +490,10 @@ void HtmlWriter::view(const Json *v, size_t pos) {
          fmtValue(get(v, {"camera", "far"}));
     if (const Json *fov = get(v, {"camera", "fov_y"})) o += " · fov " + fmtValue(fov) + "°";
     o += " · from " + esc(str(v, {"origin"})) + " · " + fmtMs(num(v, {"total_ms"})) + "</div>";
+    // A route's frame: which one, when, and a link to the route's plot.
+    if (const Json *r = get(v, "route"); r && r->is_object())
+        o += "<div class=\"meta route-frame\">frame " + fmtValue(get(r, "frame")) + " of route <a href=\"#route-" +
+             slug(str(r, {"name"})) + "\">" + esc(str(r, {"name"})) + "</a> at " + fmtReal(numOr(r, {"time"}, 0)) + " s</div>";
 
     const auto methods = orderingMethods(get(v, "ordering"));
     answers(v);
@@ -509,7 +513,7 @@ void HtmlWriter::view(const Json *v, size_t pos) {
     // Every other section of the view, by its key, as generic tables.
     static const std::set<std::string> handled = {"name",  "index",  "origin", "width", "height", "depth_format",
                                                   "projection", "camera", "stages", "zbuffer", "images", "total_ms",
-                                                  "depth", "audit", "raycast", "findings"};
+                                                  "depth", "audit", "raycast", "findings", "route"};
     if (v && v->is_object())
         for (auto it = v->begin(); it != v->end(); ++it) {
             if (handled.count(it.key()) || !it.value().is_structured()) continue;

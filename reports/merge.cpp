@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "reports/report.h"
+#include "reports/level_maps.h"
+#include "reports/routes.h"
 
 namespace va {
 
@@ -145,7 +147,9 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
 
     Json m;
     for (const auto &[key, value] : first.items()) {
-        if (key == "views" || key == "totals" || key == "findings" || key == "depth_curves") continue;
+        if (key == "views" || key == "totals" || key == "findings" || key == "depth_curves" || key == "routes" ||
+            key == "level_maps")
+            continue;
         m[key] = value;
     }
     m["shard"] = {{"index", 1}, {"count", 1}, {"views_total", total}};
@@ -183,6 +187,57 @@ bool mergeReports(const std::vector<std::string> &dirs, const std::string &outDi
     m["views"] = list;
     m["totals"] = reportTotals(m["views"]);
     addFindings(&m);
+    // Routes: one definition in every shard; the series come from the merged views, and so do the
+    // plots when the shards wrote them.
+    if (first.contains("routes") && first["routes"].is_array()) {
+        auto definitions = [](const Json &routes) {
+            Json d = Json::array();
+            for (const Json &r : routes) {
+                Json x = r;
+                for (const char *k : {"series", "worst", "image"}) x.erase(k);
+                d.push_back(x);
+            }
+            return d;
+        };
+        const Json defs = definitions(first["routes"]);
+        for (size_t i = 0; i < reports.size(); ++i)
+            if (!reports[i].contains("routes") || definitions(reports[i]["routes"]) != defs) {
+                *err = dirs[i] + ": the routes differ from " + dirs[0] + "'s; merge only shards of one analysis";
+                return false;
+            }
+        m["routes"] = defs;
+        addRouteSeries(&m);
+        bool plotted = false;
+        for (const Json &r : first["routes"]) plotted |= r.contains("image");
+        if (plotted && !writeRoutePlots(&m, outDir, err)) return false;
+    }
+    // Level maps: one floor plan in every shard (the same render); positions and values from the
+    // merged views, the images redrawn over shard 1's floor plan when the shards wrote them.
+    if (first.contains("level_maps") && first["level_maps"].is_object()) {
+        auto floorOf = [](const Json &r) {
+            Json f = r.contains("level_maps") && r["level_maps"].contains("floor") ? r["level_maps"]["floor"] : Json();
+            if (f.is_object()) f.erase("ms");
+            return f;
+        };
+        for (size_t i = 0; i < reports.size(); ++i)
+            if (floorOf(reports[i]) != floorOf(first)) {
+                *err = dirs[i] + ": the level map's floor plan differs from " + dirs[0] +
+                       "'s; merge only shards of one analysis";
+                return false;
+            }
+        m["level_maps"] = {{"floor", first["level_maps"]["floor"]}};
+        addLevelMaps(&m);
+        const fs::path floor = fs::path(dirs[0]) / kFloorPlanImage;
+        if (fs::exists(floor)) {
+            std::error_code ec;
+            fs::copy_file(floor, fs::path(outDir) / kFloorPlanImage, fs::copy_options::overwrite_existing, ec);
+            if (ec) {
+                *err = floor.string() + ": cannot copy (" + ec.message() + ")";
+                return false;
+            }
+            if (!writeLevelMapImages(&m, outDir, err)) return false;
+        }
+    }
     *merged = std::move(m);
     return true;
 }

@@ -15,6 +15,8 @@
 #include "reports/ordering_images.h"
 #include "reports/report.h"
 #include "reports/report_model.h"
+#include "reports/level_maps.h"
+#include "reports/routes.h"
 
 namespace va {
 
@@ -448,6 +450,9 @@ Json viewJson(const ViewResult &v, const std::string &base, const std::vector<st
     vj["name"] = v.spec.name;
     vj["index"] = v.index;
     vj["origin"] = v.spec.origin;
+    // A route's frame (docs/routes.md): only on views sampled from a route.
+    if (v.spec.route.onRoute())
+        vj["route"] = {{"name", v.spec.route.route}, {"frame", v.spec.route.frame}, {"time", num(v.spec.route.time)}};
     vj["width"] = v.spec.camera.width;
     vj["height"] = v.spec.camera.height;
     vj["depth_format"] = depthFormatName(v.spec.depthFormat);
@@ -493,6 +498,18 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
     j["views"] = views;
     j["totals"] = reportTotals(j["views"]);
     addFindings(&j);
+    // Routes (docs/routes.md): their definitions, then their series from the views.
+    if (!r.routes.empty()) {
+        Json routes = Json::array();
+        for (const Route &route : r.routes) routes.push_back(routeDefinitionJson(route));
+        j["routes"] = routes;
+        addRouteSeries(&j);
+    }
+    // Level maps (docs/level-maps.md): the floor plan, then the positions and values from the views.
+    if (r.floorPlan) {
+        j["level_maps"] = {{"floor", floorPlanJson(*r.floorPlan)}};
+        addLevelMaps(&j);
+    }
     return j;
 }
 

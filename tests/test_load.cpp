@@ -435,7 +435,7 @@ TEST(LoadScene, ViewErrors) {
         {"{ \"eye\": [0, 0, 5], \"target\": [0, 0, 0], \"width\": 0 }",
          "5:51: views[0].width: must be at least 1, got 0"},
         {"{ \"eye\": [0, 0, 5], \"target\": [0, 0, 0], \"width\": 100000 }",
-         "5:51: views[0].width: 100000 exceeds the limit of 16384 pixels (kMaxViewSize in analysis/load/load_scene.cpp; "
+         "5:51: views[0].width: 100000 exceeds the limit of 16384 pixels (kMaxViewSize in analysis/load/json_reader.h; "
          "it can be raised there)"},
         {"{ \"eye\": [0, 0, 5], \"target\": [0, 0, 0], \"height\": 10.5 }",
          "5:52: views[0].height: expected a whole number of pixels, got 10.5"},

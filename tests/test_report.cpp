@@ -338,6 +338,39 @@ TEST(ReportJson, QuakeMapSectionsValidate) {
 }
 
 // The validator must be able to fail, or the test above proves nothing.
+// Routes and level maps (docs/routes.md, docs/level-maps.md): a route's definition, its frames'
+// "route" and series, and the level maps' floor, positions and maps, valid against the schema.
+TEST(ReportJson, RoutesAndLevelMapsValidate) {
+    AnalysisResult r = syntheticResult();
+    Route route;
+    route.name = "walk";
+    route.file = "walk.route.json";
+    route.keyframes.resize(2);
+    route.keyframes[0].target = Vec3{0, 0, 0};
+    route.keyframes[1].time = 2;
+    route.sampling.kind = RouteSampling::Kind::every;
+    route.sampling.every = 0.5;
+    r.routes = {route};
+    r.views[0].spec.route = {"walk", 0, 0.0};
+    r.views[1].spec.route = {"walk", 1, 0.5};
+    FloorPlan f;
+    f.width = 40, f.height = 20, f.up = 'y', f.worldPerPixel = 0.5, f.drawnPixels = 7;
+    f.camera.orthographic = true, f.camera.eye = {0, 60, 0}, f.camera.target = {0, 59, 0}, f.camera.up = {0, 0, -1};
+    f.camera.orthoHeight = 10, f.camera.nearZ = 1, f.camera.farZ = 80, f.camera.width = 40, f.camera.height = 20;
+    r.floorPlan = f;
+    const Json report = reportJson(r);
+    ASSERT_TRUE(report.contains("routes"));
+    ASSERT_TRUE(report.contains("level_maps"));
+    EXPECT_EQ(report["routes"][0]["series"]["view"], (Json{0, 1}));
+    EXPECT_EQ(report["routes"][0]["sampling"], (Json{{"every_seconds", 0.5}}));
+    // The orthographic views stand at (0, 50, 0): on the plan, one position of four views.
+    ASSERT_EQ(report["level_maps"]["positions"].size(), 1u);
+    EXPECT_EQ(report["level_maps"]["positions"][0]["views"], (Json{1, 2, 3, 4}));
+    const auto errors = validateReport(loadSchema(), report);
+    for (const auto &e : errors) ADD_FAILURE() << e;
+    EXPECT_TRUE(errors.empty());
+}
+
 TEST(ReportJson, ValidatorRejectsBrokenReports) {
     const Json schema = loadSchema();
     const Json good = reportJson(syntheticResult());
@@ -722,6 +755,37 @@ TEST(ReportImages, LargeImageKeepsWidthAndScalesLegend) {
     EXPECT_EQ(o.height, 2 + 42);  // scale 2 for images 1024+ wide: strip 21 * 2
     EXPECT_EQ(rgbAt(o, 0, 0), (Px{255, 255, 255}));
     EXPECT_EQ(rgbAt(o, 1, 0), (Px{32, 64, 255}));
+}
+
+// PNGs with at most 256 colors are stored with a palette (IHDR color type 3), others as RGB
+// (type 2); either reads back as the same RGB pixels. 256 colors is the last palette image, 257
+// the first RGB one; identical rows (copied indices) and colors in scattered order included.
+TEST(ReportImages, PngPaletteUpTo256Colors) {
+    TempDir dir;
+    for (const int colors : {1, 5, 256, 257, 4096}) {
+        const int W = 97, H = 61;
+        std::vector<uint8_t> rgb(size_t(W) * H * 3);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                // Rows 10..19 repeat row 9; colors spread over all channels by a multiplicative hash.
+                const int yy = (y >= 10 && y < 20) ? 9 : y;
+                const uint32_t c = uint32_t((yy * W + x) * 2654435761u % uint32_t(colors)) * 40503u;
+                uint8_t *p = &rgb[(size_t(y) * W + x) * 3];
+                p[0] = uint8_t(c), p[1] = uint8_t(c >> 8), p[2] = uint8_t(c >> 16);
+            }
+        const std::string path = dir.path + "/c" + std::to_string(colors) + ".png";
+        std::string err;
+        ASSERT_TRUE(writePngRgb8(path, W, H, rgb.data(), &err)) << err;
+        const std::string bytes = fileBytes(path);
+        ASSERT_GT(bytes.size(), 26u);
+        EXPECT_EQ(int(uint8_t(bytes[25])), colors <= 256 ? 3 : 2) << colors << " colors";
+        ImageData d;
+        ASSERT_TRUE(readImage(path, &d, &err)) << err;
+        ASSERT_EQ(d.channels(), 3);
+        EXPECT_EQ(d.width, W);
+        EXPECT_EQ(d.height, H);
+        EXPECT_TRUE(d.u8 == rgb) << colors << " colors: pixels differ after reading back";
+    }
 }
 
 TEST(ReportImages, Errors) {
