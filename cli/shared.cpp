@@ -172,7 +172,7 @@ void addSceneOptions(CLI::App *c, SceneOptions &o) {
                                     "none = the built-in demo");
     c->add_option("--views", o.views, "Views: a views file (.json); orbit:N (N cameras around the scene); "
                                       "route:FILE[:N|:Ts] (a route file's keyframes, N frames, or a frame every T "
-                                      "seconds); grid:N[:D] (N positions over the floor plan, D directions each); for a "
+                                      "seconds); grid:N[:D] (N positions over the floor plan, D directions each, default 4); for a "
                                       "Quake 3 map, spawns (its spawn points), walk:N[:SEED] (N points inside its "
                                       "clusters) or clusters[:D] (one position per cluster)");
     c->add_option("--eye-height", o.eyeHeight,

@@ -9,10 +9,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
+#include "analysis/load/level_views.h"
+#include "analysis/load/load.h"
 #include "analysis/load/route.h"
 #include "analysis/pipeline.h"
 #include "reports/report.h"
@@ -175,6 +179,41 @@ TEST(Route, CubeRouteCountsAreExactPerFrame) {
     size_t red = 0;
     for (size_t p = 0; p < plot.rgb.size(); p += 3) red += plot.rgb[p] == 210 && plot.rgb[p + 1] == 40 && plot.rgb[p + 2] == 30;
     EXPECT_GT(red, 0u);
+}
+
+// route:spawns on a real map: its spawn points (not the intermissions), nearest first, at the run
+// speed; refused on a scene that is not a map.
+TEST(Route, SpawnsRouteWalksAMapsSpawnPoints) {
+    std::string err;
+    Route r;
+    Scene cube = testing_util::sceneOf({cubeMesh()});
+    cube.path = "cube.obj";
+    EXPECT_FALSE(spawnRoute(cube, &r, &err));
+    EXPECT_EQ(err, "'cube.obj' is not a Quake 3 map; route:spawns walks a map's spawn points (write a route file instead)");
+    const std::string thor = std::string(VISAUDIT_TEST_DATA) + "/openarena/pak6-patch088.pk3";
+    if (!fs::exists(thor)) GTEST_SKIP() << "real data not fetched (run scripts/fetch-data.sh)";
+    Scene s;
+    ASSERT_TRUE(loadScene(thor + ":maps/oa_thor.bsp", {}, &s, &err)) << err;
+    ASSERT_TRUE(spawnRoute(s, &r, &err)) << err;
+    // One keyframe per distinct place (a few of oa_thor's spawn points share one).
+    std::set<std::tuple<double, double, double>> places;
+    for (const ViewSpec &v : spawnViews(s))
+        if (v.name.rfind("spawn", 0) == 0) places.insert({v.camera.eye.x, v.camera.eye.y, v.camera.eye.z});
+    EXPECT_EQ(r.keyframes.size(), places.size());
+    EXPECT_EQ(r.keyframes[0].eye, spawnViews(s)[0].camera.eye);
+    EXPECT_EQ(r.speed, 320);
+    EXPECT_EQ(r.interpolation, RouteInterpolation::linear);
+    for (size_t k = 1; k < r.keyframes.size(); ++k) {
+        EXPECT_GT(r.keyframes[k].time, r.keyframes[k - 1].time);
+        EXPECT_NEAR(r.keyframes[k].time - r.keyframes[k - 1].time,
+                    length(r.keyframes[k].eye - r.keyframes[k - 1].eye) / 320, 1e-9);
+    }
+    // Nearest neighbour: the second keyframe is the spawn point nearest to the first.
+    double nearest = INFINITY;
+    for (const ViewSpec &v : spawnViews(s))
+        if (v.name.rfind("spawn", 0) == 0 && !(v.camera.eye == r.keyframes[0].eye))
+            nearest = std::min(nearest, length(v.camera.eye - r.keyframes[0].eye));
+    EXPECT_EQ(length(r.keyframes[1].eye - r.keyframes[0].eye), nearest);
 }
 
 class RouteFileTest : public testing_util::TempDirTest {

@@ -218,7 +218,7 @@ std::vector<ViewSpec> gridViews(const Scene &scene, int n, int dirs, double eyeH
     }
     std::vector<Vec3> eyes;
     lattice(lo, &eyes);
-    const std::string origin = "grid:" + std::to_string(n) + (dirs == 1 ? "" : ":" + std::to_string(dirs));
+    const std::string origin = "grid:" + std::to_string(n) + ":" + std::to_string(dirs);
     for (int k = 0; k < n; ++k) {
         const size_t pick = size_t((unsigned __int128)k * eyes.size() / size_t(n));
         positionViews(scene, "grid" + std::to_string(k), origin, eyes[pick], dirs, eyeHeight, &views);
@@ -238,7 +238,7 @@ std::vector<ViewSpec> clusterViews(const Scene &scene, int dirs) {
             (lv.leafInTree.empty() || lv.leafInTree[i]))
             leafsOf[size_t(l.cluster)].push_back(uint32_t(i));
     }
-    const std::string origin = "clusters" + (dirs == 1 ? std::string() : ":" + std::to_string(dirs));
+    const std::string origin = "clusters:" + std::to_string(dirs);
     for (size_t c = 0; c < leafsOf.size(); ++c) {
         std::vector<uint32_t> &ls = leafsOf[c];
         auto area = [&](uint32_t i) {
@@ -277,12 +277,12 @@ bool levelViews(const std::string &spec, const Scene &scene, std::vector<ViewSpe
         const std::string rest = spec.substr(5);
         const size_t colon = rest.find(':');
         const std::string ns = rest.substr(0, colon), ds = colon == std::string::npos ? "" : rest.substr(colon + 1);
-        int dirs = 1;
+        int dirs = 4;  // the four quarters of the horizon (Quake's 90-degree lens: a full panorama)
         if (ns.empty() || ns.size() > 6 || ns.find_first_not_of("0123456789") != std::string::npos ||
             std::stol(ns) < 1 || std::stol(ns) > 100000 || (colon != std::string::npos && ds.empty()) ||
             !directions(ds, &dirs)) {
             *err = "--views " + spec + ": expected grid:N or grid:N:D with N positions in 1..100000 and D directions "
-                   "per position in 1..8, e.g. grid:200 or grid:200:4";
+                   "per position in 1..8 (default 4), e.g. grid:200 or grid:200:1";
             return false;
         }
         *out = gridViews(scene, int(std::stol(ns)), dirs, eyeHeight, err);
@@ -294,10 +294,10 @@ bool levelViews(const std::string &spec, const Scene &scene, std::vector<ViewSpe
         return false;
     }
     if (clusters) {
-        int dirs = 1;
+        int dirs = 4;
         if (!directions(spec.size() > 9 ? spec.substr(9) : "", &dirs) || spec == "clusters:") {
-            *err = "--views " + spec + ": expected clusters or clusters:D with D directions per position in 1..8, "
-                   "e.g. clusters:4";
+            *err = "--views " + spec + ": expected clusters or clusters:D with D directions per position in 1..8 "
+                   "(default 4), e.g. clusters:1";
             return false;
         }
         *out = clusterViews(scene, dirs);

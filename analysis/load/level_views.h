@@ -39,9 +39,10 @@ std::vector<ViewSpec> spawnViews(const Scene &scene);
 std::vector<ViewSpec> walkViews(const Scene &scene, int n, uint64_t seed = 1);
 
 // Views at sample positions covering a level, each position seen in `dirs` directions (yaws 0,
-// 360/dirs, ...; horizontal, as route.h's yaw): the level maps colour each position by the worst
-// of its views (docs/level-maps.md). Positions "gridK" / "clusterK", views "gridK" (one direction)
-// or "gridK-yawD".
+// 360/dirs, ...; horizontal, as route.h's yaw; 4 by default: the four quarters of the horizon, a
+// full panorama with Quake 3's 90-degree lens): the level maps colour each position by the worst
+// of its views (docs/level-maps.md). Positions "gridK" / "clusterC", views "gridK" (one
+// direction) or "gridK-yawD"; origin "grid:N:D" / "clusters:D".
 //
 // grid:N -- N positions on a square lattice over the level's floor plan (analysis/level_map.h,
 // rendered from above through the project's rasterizer): lattice points on a surface a player can
@@ -55,7 +56,7 @@ std::vector<ViewSpec> gridViews(const Scene &scene, int n, int dirs, double eyeH
 std::vector<ViewSpec> clusterViews(const Scene &scene, int dirs);
 
 // Parses a --views value naming level views: "spawns", "walk:N", "walk:N:SEED", "grid:N",
-// "grid:N:D", "clusters", "clusters:D". Returns false with a message when the value is malformed or
+// "grid:N:D", "clusters", "clusters:D" (D directions per position, 1..8, default 4). Returns false with a message when the value is malformed or
 // the scene cannot give such views (not a map, no spawn points, no clusters). `handled` is false
 // (and nothing else happens) for other values. `eyeHeight` (grid:N) 0: the scene's default.
 bool levelViews(const std::string &spec, const Scene &scene, std::vector<ViewSpec> *out, bool *handled,
