@@ -325,6 +325,18 @@ bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, C
     return true;
 }
 
+std::vector<uint32_t> objectStagesKept(const PreparedScene &ps, const ViewSpec &view, const Camera &cam,
+                                       const PipelineSettings &s) {
+    ViewResult r;
+    r.spec = view;
+    r.camera = cam;
+    ViewContext c{ps, *ps.scene, view, cam, s, r, {}};
+    std::vector<uint32_t> objects(c.scene.objects.size());
+    for (uint32_t i = 0; i < objects.size(); ++i) objects[i] = i;
+    for (const ObjectStage *stage : kObjectStages) runObjectStage(c, *stage, objects);
+    return objects;
+}
+
 ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Camera &cam, const PipelineSettings &s) {
     const Stopwatch tView;
     ViewResult r;

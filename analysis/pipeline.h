@@ -92,6 +92,11 @@ bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *
 // The view after settings' overrides, validated; false with a message naming the view and a fix.
 bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, Camera *cam, std::string *err);
 
+// The culling objects the object stages (cells or grid, frustum, occlusion) keep for one (resolved)
+// view, ascending: the backface stage's input, as analyzeView runs it (assignment kits).
+std::vector<uint32_t> objectStagesKept(const PreparedScene &ps, const ViewSpec &view, const Camera &cam,
+                                       const PipelineSettings &s);
+
 // Runs every stage for one (resolved) view.
 ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Camera &cam, const PipelineSettings &s);
 

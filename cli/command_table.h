@@ -13,6 +13,7 @@ CommandRun setupInfo(CLI::App *c);        // cli/cmd_info.cpp
 CommandRun setupAnalyze(CLI::App *c);     // cli/cmd_analyze.cpp
 CommandRun setupCheck(CLI::App *c);       // cli/cmd_analyze.cpp
 CommandRun setupGrade(CLI::App *c);       // cli/cmd_grade.cpp
+CommandRun setupAssignment(CLI::App *c);  // cli/cmd_assignment.cpp
 CommandRun setupMerge(CLI::App *c);       // cli/cmd_merge.cpp
 CommandRun setupDiff(CLI::App *c);        // cli/cmd_diff.cpp
 CommandRun setupDepthAudit(CLI::App *c);  // cli/cmd_depth_audit.cpp

@@ -30,8 +30,12 @@ const Command kCommands[] = {
     {"analyze", "Run every stage for every view; write report.json and images to --out", setupAnalyze},
     {"check", "Analyze, then fail (exit 1) when a view exceeds its budget or regresses against a baseline",
      setupCheck},
-    {"grade", "Score a student's per-stage counts against a reference report (exit 1 on any failure)",
+    {"grade", "Score a student's per-stage counts against a reference report, or submissions against an assignment kit's "
+              "answers (--kit): grade.html, grades.csv",
      setupGrade},
+    {"assignment", "Make an assignment kit (each stage's exact input per view, the conventions, a submission template) "
+                   "and its reference answers",
+     setupAssignment},
     {"merge", "Join the reports of analyze --shard K/N runs into one report", setupMerge},
     {"diff", "Compare two runs: per view and route frame the metric deltas, the level maps of the change, image "
              "diffs; exit 1 when a regression exceeds the budget",

@@ -71,8 +71,12 @@ bool parseFile(const std::string &file, Doc *doc, std::string *err, uint64_t max
     }
     std::ostringstream ss;
     ss << f.rdbuf();
+    return parseText(file, std::move(ss).str(), doc, err, maxDepth);
+}
+
+bool parseText(const std::string &file, std::string text, Doc *doc, std::string *err, uint64_t maxDepth) {
     doc->file = file;
-    doc->text = std::move(ss).str();
+    doc->text = std::move(text);
     if (!checkDepth(doc->text, file, maxDepth, err)) return false;
     try {
         doc->root = Json::parse(doc->text);

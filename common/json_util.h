@@ -61,6 +61,9 @@ bool checkDepth(std::string_view text, const std::string &file, uint64_t maxDept
 
 // Reads and parses `file`, after checkDepth. Syntax errors: "FILE:LINE:COL: JSON syntax error: ...".
 bool parseFile(const std::string &file, Doc *doc, std::string *err, uint64_t maxDepth = kDefaultMaxJsonDepth);
+// The same for a text already in memory (`file` names it in messages).
+bool parseText(const std::string &file, std::string text, Doc *doc, std::string *err,
+               uint64_t maxDepth = kDefaultMaxJsonDepth);
 
 // Byte offset of the value at `p` (or of its key's opening quote when `key` is true); the offset of
 // the deepest existing ancestor when the path does not exist.

@@ -1,5 +1,6 @@
 #include "render/clip.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "render/large_pages.h"
@@ -10,13 +11,10 @@ const char *const kClipPlaneNames[kClipPlaneCount] = {"near", "far", "left", "ri
 
 namespace {
 
-// A vertex in the clipper's space: clip-space x, y, w and the view depth d. All four are linear
+// ClipVertex (clip.h): clip-space x, y, w and the view depth d. All four are linear
 // (perspective: w = d) or affine (orthographic: w = 1) functions of the view-space position, so
 // linear interpolation between two vertices is exactly interpolation of the view-space segment,
 // and every clip plane below is a linear function of (x, y, w, d).
-struct ClipVertex {
-    double x, y, w, d;
-};
 
 // Outcode bits: the view frustum's planes, then the guard band's side planes.
 enum : uint32_t {
@@ -98,6 +96,99 @@ int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, Cli
     return m;
 }
 
+// One triangle through the stage: trivial reject, depth plane, accept or Sutherland-Hodgman, fan
+// triangulation, projection. v*: its corners in view space; c*: in the clipper's space; code*:
+// their outcodes; s*: their projected fixed-point positions (read only when the triangle is
+// accepted whole, i.e. every corner is inside near, far and the guard band). Inlined into both
+// entry points, so clipTriangles' loop is what it was.
+[[gnu::always_inline]] inline void clipOne(const Camera &cam, const ClipSpace &cs, uint32_t t, const Vec3 &v0,
+                                           const Vec3 &v1, const Vec3 &v2, const ClipVertex *cv0,
+                                           const ClipVertex *cv1, const ClipVertex *cv2, uint32_t c0, uint32_t c1,
+                                           uint32_t c2, const int32_t *s0, const int32_t *s1, const int32_t *s2,
+                                           ClipStats &st, ScreenTriangles &out, std::vector<ClipPolygon> *polygons) {
+    // Trivial reject: all three vertices outside one plane of the view frustum.
+    if ((c0 & c1 & c2 & kFrustumBits) != 0) {
+        ++st.trivialRejected;
+        return;
+    }
+    const DepthPlane plane = depthPlaneFromView(cam, v0, v1, v2);
+    if (!plane.valid) {
+        ++st.edgeOn;
+        return;
+    }
+    const uint32_t any = c0 | c1 | c2;
+    if ((any & (kOutNear | kOutFar | kGuardBits)) == 0) {
+        // Inside, or crossing a viewport side while staying in the guard band: the
+        // rasterizer's bounding box and edge functions do the 2D clipping.
+        if (any == 0)
+            ++st.inside;
+        else
+            ++st.guardBandAccepted;
+        const uint32_t pi = uint32_t(out.planes.size());
+        out.planes.push_back(plane);
+        out.xy.insert(out.xy.end(), {s0[0], s0[1], s1[0], s1[1], s2[0], s2[1]});
+        out.source.push_back(t);
+        out.plane.push_back(pi);
+        ++st.trianglesOut;
+        if (polygons) polygons->push_back({t, {*cv0, *cv1, *cv2}});
+        return;
+    }
+
+    // Sutherland-Hodgman in homogeneous clip space, before the divide. Near is clipped
+    // first (whenever any vertex is behind it), so nothing behind the eye is projected.
+    ++st.clipped;
+    ClipVertex bufA[16], bufB[16];
+    ClipVertex *src = bufA, *dst = bufB;
+    src[0] = *cv0;
+    src[1] = *cv1;
+    src[2] = *cv2;
+    int n = 3;
+    for (int p = 0; p < kClipPlaneCount && n >= 3; ++p) {
+        const uint32_t bit = p < 2 ? (1u << p) : guardBit(p);
+        if (!(any & bit)) continue;
+        ++st.perPlane[p];
+        n = clipPolygon(cs, p, src, n, dst);  // each plane adds at most one vertex: n <= 9
+        std::swap(src, dst);
+    }
+    if (n < 3) {
+        ++st.clippedAway;
+        return;
+    }
+    ++st.polygonVertices[n < 9 ? n : 9];
+    const uint32_t pi = uint32_t(out.planes.size());
+    out.planes.push_back(plane);
+    int32_t p0[2], pa[2], pb[2];
+    cs.project(src[0], p0);
+    cs.project(src[1], pb);
+    for (int v = 2; v < n; ++v) {  // fan from the first vertex
+        pa[0] = pb[0];
+        pa[1] = pb[1];
+        cs.project(src[v], pb);
+        out.xy.insert(out.xy.end(), {p0[0], p0[1], pa[0], pa[1], pb[0], pb[1]});
+        out.source.push_back(t);
+        out.plane.push_back(pi);
+        ++st.trianglesOut;
+    }
+    if (polygons) polygons->push_back({t, std::vector<ClipVertex>(src, src + n)});
+}
+
+ClipSpace clipSpaceOf(const Camera &cam, const ClipSettings &settings) {
+    ClipSpace cs;
+    cs.nearZ = cam.nearZ;
+    cs.farZ = cam.farZ;
+    cs.halfW = 0.5 * cam.width;
+    cs.halfH = 0.5 * cam.height;
+    cs.gx = 1 + settings.guardBandPixels / cs.halfW;
+    cs.gy = 1 + settings.guardBandPixels / cs.halfH;
+    return cs;
+}
+
+// A view-space point in the clipper's space (camera.h).
+ClipVertex clipVertexOf(const Camera &cam, const Vec3 &v) {
+    const double d = -v.z;
+    return {cam.sx * v.x, cam.sy * v.y, cam.orthographic ? 1.0 : d, d};
+}
+
 }  // namespace
 
 ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vector<ClipBatch> &batches,
@@ -106,13 +197,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     ClipStats &st = r.stats;
     ScreenTriangles &out = r.out;
 
-    ClipSpace cs;
-    cs.nearZ = cam.nearZ;
-    cs.farZ = cam.farZ;
-    cs.halfW = 0.5 * cam.width;
-    cs.halfH = 0.5 * cam.height;
-    cs.gx = 1 + settings.guardBandPixels / cs.halfW;
-    cs.gy = 1 + settings.guardBandPixels / cs.halfH;
+    const ClipSpace cs = clipSpaceOf(cam, settings);
 
     size_t total = 0;
     for (const ClipBatch &b : batches) total += b.count;
@@ -140,8 +225,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
         for (uint32_t i = 0; i < nv; ++i) {
             const Vec3 v = transformPoint(vw, mesh.positions[b.vertexBegin + i]);
             view[i] = v;
-            const double d = -v.z;
-            ClipVertex c{cam.sx * v.x, cam.sy * v.y, cam.orthographic ? 1.0 : d, d};
+            const ClipVertex c = clipVertexOf(cam, v);
             cv[i] = c;
             code[i] = cs.outcode(c);
             if ((code[i] & (kOutNear | kOutFar | kGuardBits)) == 0) cs.project(c, &screen[size_t(i) * 2]);
@@ -153,73 +237,32 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
             const uint32_t i0 = mesh.indices[3 * size_t(t)] - b.vertexBegin;
             const uint32_t i1 = mesh.indices[3 * size_t(t) + 1] - b.vertexBegin;
             const uint32_t i2 = mesh.indices[3 * size_t(t) + 2] - b.vertexBegin;
-            const uint32_t c0 = code[i0], c1 = code[i1], c2 = code[i2];
 
-            // Trivial reject: all three vertices outside one plane of the view frustum.
-            if ((c0 & c1 & c2 & kFrustumBits) != 0) {
-                ++st.trivialRejected;
-                continue;
-            }
-            const DepthPlane plane = depthPlaneFromView(cam, view[i0], view[i1], view[i2]);
-            if (!plane.valid) {
-                ++st.edgeOn;
-                continue;
-            }
-            const uint32_t any = c0 | c1 | c2;
-            if ((any & (kOutNear | kOutFar | kGuardBits)) == 0) {
-                // Inside, or crossing a viewport side while staying in the guard band: the
-                // rasterizer's bounding box and edge functions do the 2D clipping.
-                if (any == 0)
-                    ++st.inside;
-                else
-                    ++st.guardBandAccepted;
-                const uint32_t pi = uint32_t(out.planes.size());
-                out.planes.push_back(plane);
-                const int32_t *s0 = &screen[size_t(i0) * 2], *s1 = &screen[size_t(i1) * 2],
-                              *s2 = &screen[size_t(i2) * 2];
-                out.xy.insert(out.xy.end(), {s0[0], s0[1], s1[0], s1[1], s2[0], s2[1]});
-                out.source.push_back(t);
-                out.plane.push_back(pi);
-                ++st.trianglesOut;
-                continue;
-            }
-
-            // Sutherland-Hodgman in homogeneous clip space, before the divide. Near is clipped
-            // first (whenever any vertex is behind it), so nothing behind the eye is projected.
-            ++st.clipped;
-            ClipVertex bufA[16], bufB[16];
-            ClipVertex *src = bufA, *dst = bufB;
-            src[0] = cv[i0];
-            src[1] = cv[i1];
-            src[2] = cv[i2];
-            int n = 3;
-            for (int p = 0; p < kClipPlaneCount && n >= 3; ++p) {
-                const uint32_t bit = p < 2 ? (1u << p) : guardBit(p);
-                if (!(any & bit)) continue;
-                ++st.perPlane[p];
-                n = clipPolygon(cs, p, src, n, dst);  // each plane adds at most one vertex: n <= 9
-                std::swap(src, dst);
-            }
-            if (n < 3) {
-                ++st.clippedAway;
-                continue;
-            }
-            ++st.polygonVertices[n < 9 ? n : 9];
-            const uint32_t pi = uint32_t(out.planes.size());
-            out.planes.push_back(plane);
-            int32_t p0[2], pa[2], pb[2];
-            cs.project(src[0], p0);
-            cs.project(src[1], pb);
-            for (int v = 2; v < n; ++v) {  // fan from the first vertex
-                pa[0] = pb[0];
-                pa[1] = pb[1];
-                cs.project(src[v], pb);
-                out.xy.insert(out.xy.end(), {p0[0], p0[1], pa[0], pa[1], pb[0], pb[1]});
-                out.source.push_back(t);
-                out.plane.push_back(pi);
-                ++st.trianglesOut;
-            }
+            clipOne(cam, cs, t, view[i0], view[i1], view[i2], &cv[i0], &cv[i1], &cv[i2], code[i0], code[i1], code[i2],
+                    &screen[size_t(i0) * 2], &screen[size_t(i1) * 2], &screen[size_t(i2) * 2], st, out, nullptr);
         }
+    }
+    return r;
+}
+
+ClipResult clipViewTriangles(const Camera &cam, const std::vector<Vec3> &view, const std::vector<uint32_t> &source,
+                             const ClipSettings &settings, std::vector<ClipPolygon> *polygons) {
+    ClipResult r;
+    const ClipSpace cs = clipSpaceOf(cam, settings);
+    const size_t n = std::min(view.size() / 3, source.size());
+    r.stats.trianglesIn = n;
+    for (size_t t = 0; t < n; ++t) {
+        const Vec3 *v = &view[3 * t];
+        ClipVertex cv[3];
+        uint32_t code[3];
+        int32_t screen[6] = {};
+        for (int k = 0; k < 3; ++k) {
+            cv[k] = clipVertexOf(cam, v[k]);
+            code[k] = cs.outcode(cv[k]);
+            if ((code[k] & (kOutNear | kOutFar | kGuardBits)) == 0) cs.project(cv[k], &screen[2 * k]);
+        }
+        clipOne(cam, cs, source[t], v[0], v[1], v[2], &cv[0], &cv[1], &cv[2], code[0], code[1], code[2], &screen[0],
+                &screen[2], &screen[4], r.stats, r.out, polygons);
     }
     return r;
 }

@@ -61,4 +61,25 @@ struct ClipResult {
 ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vector<ClipBatch> &batches,
                          const ClipSettings &settings);
 
+// A vertex in the clipper's space: clip-space x, y, w and the view depth d (camera.h). From a
+// view-space point (x, y, z): (sx x, sy y, w, -z) with w = -z (perspective) or 1 (orthographic).
+struct ClipVertex {
+    double x, y, w, d;
+};
+// A polygon that reaches the rasterizer: a triangle accepted whole (its three corners), or what
+// Sutherland-Hodgman left of a clipped one (3 to 9 vertices, fanned from the first).
+struct ClipPolygon {
+    uint32_t source = 0;
+    std::vector<ClipVertex> vertices;
+};
+
+// The clip stage on triangles given by their view-space corners (an assignment kit's clip input,
+// analysis/kit.h): view[3 t + k] is corner k of triangle t, source[t] its id, in submission order.
+// clipTriangles is this after transforming each vertex with cam.viewFromWorld: the same
+// classification, clipping, depth plane and projection, so the same screen triangles and counts.
+// `polygons` (optional) receives, in order, the polygon of every triangle that reaches the
+// rasterizer (inside, guard-band accepted, or clipped to 3 or more vertices).
+ClipResult clipViewTriangles(const Camera &cam, const std::vector<Vec3> &view, const std::vector<uint32_t> &source,
+                             const ClipSettings &settings, std::vector<ClipPolygon> *polygons = nullptr);
+
 }  // namespace va

@@ -66,6 +66,17 @@ bool loadTolerances(const std::string &path, ToleranceRules *out, std::string *e
     return true;
 }
 
+Tolerance toleranceFor(const ToleranceRules &t, const std::string &metric, Tolerance builtin) {
+    Tolerance tol = t.hasDefault ? t.defaults : builtin;
+    for (const auto &[rule, value] : t.rules) {
+        const bool wildcard = rule.size() >= 2 && rule.compare(rule.size() - 2, 2, ".*") == 0;
+        if (rule == metric || (wildcard && metric.compare(0, rule.size() - 1, rule, 0, rule.size() - 1) == 0) ||
+            (metric.compare(0, rule.size() + 1, rule + ".") == 0))
+            tol = value;
+    }
+    return tol;
+}
+
 namespace {
 
 bool isTiming(const std::string &k) { return k == "ms" || (k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0); }
@@ -124,14 +135,7 @@ std::vector<std::pair<std::string, OJson>> viewMetrics(const OJson &view) {
 }
 
 Tolerance toleranceFor(const ToleranceRules &t, const std::string &metric, bool integer) {
-    Tolerance tol = t.hasDefault ? t.defaults : Tolerance{0, integer ? 0 : 1e-9};
-    for (const auto &[rule, value] : t.rules) {
-        const bool wildcard = rule.size() >= 2 && rule.compare(rule.size() - 2, 2, ".*") == 0;
-        if (rule == metric || (wildcard && metric.compare(0, rule.size() - 1, rule, 0, rule.size() - 1) == 0) ||
-            (metric.compare(0, rule.size() + 1, rule + ".") == 0))
-            tol = value;
-    }
-    return tol;
+    return va::toleranceFor(t, metric, Tolerance{0, integer ? 0 : 1e-9});
 }
 
 std::string show(const OJson &v) { return v.is_null() ? "null" : v.dump(); }

@@ -33,12 +33,18 @@ struct GradeItem {
     std::string view, stage, key;
     std::string reference, submitted;  // formatted; "missing" when the submission lacks it
     bool pass = true;
+    std::string note;                  // kit grading: what a list or image comparison found (or "")
 };
 struct GradeResult {
     std::vector<GradeItem> items;  // views in reference order, stages in reference order
     size_t passed = 0, failed = 0;
     double score = 0;              // passed / items, in [0, 1]
 };
+
+// The tolerance of `metric` under the rules: the last rule naming it ("clip.triangles_out"), a
+// wildcard covering it ("clip.*") or a prefix of it ("clip.per_plane" covers "clip.per_plane.near");
+// else the file's default; else `builtin`.
+Tolerance toleranceFor(const ToleranceRules &t, const std::string &metric, Tolerance builtin);
 
 // Compares the submission with the reference. False + message when either is not a report.
 bool gradeReports(const nlohmann::ordered_json &reference, const nlohmann::ordered_json &submission,

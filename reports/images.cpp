@@ -1,11 +1,12 @@
-// Per-view images through OpenImageIO (the only file that includes OIIO headers).
+// Per-view images: PNGs through libpng (palette images, encodePng), OpenEXR and reading through
+// OpenImageIO (the only file that includes either's headers).
 //
 //   BASE.depth.exr     one FLOAT channel "Z": the visible fragment's view depth d (double rounded to
 //                      float); background (no fragment) = +inf, so "nothing" is never mistaken for a
 //                      depth and min() over a region still picks the nearest surface.
 //   BASE.depth.png     8-bit gray visualization of the same depths (depthGray: log scale, near
 //                      white, far dark, background black).
-//   BASE.overdraw.png  RGB heatmap of depth complexity (ZBuffer::fragments per pixel) with a legend
+//   BASE.overdraw.png  heatmap of depth complexity (ZBuffer::fragments per pixel) with a legend
 //                      strip added below the image (the image itself is never covered).
 //   BASE.ids.exr       one UINT32 channel "id": 1 + the visible source triangle index, 0 = background.
 #include <unistd.h>
@@ -21,6 +22,8 @@
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <png.h>
+#include <zlib.h>
 
 #include "reports/font.h"
 #include "reports/legend.h"
@@ -44,12 +47,129 @@ using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
-// Encodes one image with OpenImageIO in memory, then writes the bytes with writeFileAtomic (a
-// temporary name in the same folder, fsync, rename over `path`: readers see the old file or the
-// new one, never half). OpenImageIO's own file errors name no system reason ("Failed to write pixel
-// data"); writeFileAtomic's name the call and errno's text ("No space left on device").
-bool writeImageAtomic(const std::string &path, const char *format, const ImageSpec &spec, const void *pixels,
-                      std::string *err) {
+// ---- PNG ----------------------------------------------------------------------------------------
+// Every PNG is a visualization with few colors (a view's grays and a handful of highlight colors):
+// stored with a palette when it has at most 256, one byte per pixel instead of three, and the
+// deflate pass that dominates writing a PNG runs over a third of the bytes. The pixels read back
+// are the same either way. Measured per 1080p image (libpng 1.6, zlib 1.2.13, filter "up", zlib's
+// run-length strategy -- most rows repeat the row above, so the filter turns them into zero runs
+// and the run-length coder needs no match search): RGB 15 ms, palette 7 ms plus 1-4 ms to index it.
+
+// The distinct colors of an RGB8 image in order of first appearance and each pixel's index into
+// them; false when there are more than 256. A row equal to the one above copies its indices.
+bool paletteOf(const uint8_t *rgb, int width, int height, std::vector<uint8_t> *index, std::vector<png_color> *colors) {
+    const size_t W = size_t(width), row = 3 * W;
+    index->resize(W * size_t(height));
+    colors->clear();
+    // Open addressing over the 24-bit colors, 1024 slots for at most 256 colors.
+    constexpr uint32_t kSlots = 1024, kEmpty = 0xFFFFFFFFu;
+    uint32_t key[kSlots];
+    uint8_t value[kSlots];
+    std::fill(std::begin(key), std::end(key), kEmpty);
+    uint32_t last = kEmpty;
+    uint8_t lastIndex = 0;
+    for (size_t y = 0; y < size_t(height); ++y) {
+        const uint8_t *p = rgb + y * row;
+        uint8_t *out = index->data() + y * W;
+        if (y > 0 && std::memcmp(p, p - row, row) == 0) {
+            std::memcpy(out, out - W, W);
+            continue;
+        }
+        for (size_t x = 0; x < W; ++x, p += 3) {
+            const uint32_t k = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+            if (k != last) {
+                uint32_t h = (k * 2654435761u) >> 22;
+                while (key[h] != kEmpty && key[h] != k) h = (h + 1) & (kSlots - 1);
+                if (key[h] == kEmpty) {
+                    if (colors->size() == 256) return false;
+                    key[h] = k;
+                    value[h] = uint8_t(colors->size());
+                    colors->push_back({p[0], p[1], p[2]});
+                }
+                last = k;
+                lastIndex = value[h];
+            }
+            out[x] = lastIndex;
+        }
+    }
+    return true;
+}
+
+void appendPngBytes(png_structp png, png_bytep data, png_size_t n) {
+    static_cast<std::string *>(png_get_io_ptr(png))->append(reinterpret_cast<const char *>(data), n);
+}
+void flushNothing(png_structp) {}
+
+// libpng reports errors by longjmp to the setjmp below; nothing between them owns a resource that
+// the jump would leak (the rows are the caller's, the output string is the caller's).
+bool encodePngRows(int width, int height, int colorType, const std::vector<png_color> &palette, const uint8_t *pixels,
+                   size_t stride, std::string *out, std::string *why) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info) {
+        png_destroy_write_struct(&png, &info);
+        *why = "libpng could not allocate its writer";
+        return false;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        *why = "libpng failed to encode the image";
+        return false;
+    }
+    png_set_write_fn(png, out, appendPngBytes, flushNothing);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
+    png_set_compression_strategy(png, Z_RLE);
+    png_set_compression_level(png, 1);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, colorType, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_PLTE(png, info, palette.data(), int(palette.size()));
+    png_write_info(png, info);
+    for (int y = 0; y < height; ++y) png_write_row(png, pixels + size_t(y) * stride);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+// An 8-bit PNG of 1 (gray) or 3 (RGB) channels: RGB with a palette when it has at most 256 colors.
+bool encodePng(int width, int height, int channels, const uint8_t *pixels, std::string *out, std::string *why) {
+    if (width <= 0 || height <= 0 || (channels != 1 && channels != 3)) {
+        *why = "a PNG needs a positive size and 1 or 3 channels (got " + std::to_string(width) + "x" +
+               std::to_string(height) + "x" + std::to_string(channels) + ")";
+        return false;
+    }
+    out->clear();
+    if (channels == 1) return encodePngRows(width, height, PNG_COLOR_TYPE_GRAY, {}, pixels, size_t(width), out, why);
+    std::vector<uint8_t> index;
+    std::vector<png_color> palette;
+    if (paletteOf(pixels, width, height, &index, &palette))
+        return encodePngRows(width, height, PNG_COLOR_TYPE_PALETTE, palette, index.data(), size_t(width), out, why);
+    return encodePngRows(width, height, PNG_COLOR_TYPE_RGB, {}, pixels, 3 * size_t(width), out, why);
+}
+
+// Writes encoded bytes with writeFileAtomic (in place in a report's staging folder; elsewhere a
+// temporary name, flushed, renamed over `path`: readers see the old file or the new one, never
+// half). Its errors name the call and errno's text ("No space left on device").
+bool writeEncoded(const std::string &path, const std::string &bytes, std::string *err) {
+    std::string e;
+    if (writeFileAtomic(path, bytes, &e)) return true;
+    const std::string own = "cannot write '" + path + "': ";  // writeFileAtomic's prefix
+    if (err) *err = "cannot write image '" + path + "': " + (e.rfind(own, 0) == 0 ? e.substr(own.size()) : e);
+    return false;
+}
+
+bool writePng(const std::string &path, int width, int height, int channels, const uint8_t *pixels, std::string *err) {
+    std::string bytes, why;
+    if (!encodePng(width, height, channels, pixels, &bytes, &why)) {
+        if (err) *err = "cannot write image '" + path + "': " + why;
+        return false;
+    }
+    return writeEncoded(path, bytes, err);
+}
+
+// ---- OpenEXR --------------------------------------------------------------------------------------
+// Encodes one image with OpenImageIO in memory, then writes the bytes (writeEncoded). OpenImageIO's
+// own file errors name no system reason ("Failed to write pixel data").
+bool writeExr(const std::string &path, const ImageSpec &spec, const void *pixels, std::string *err) {
     auto fail = [&](const std::string &msg) {
         if (err) *err = "cannot write image '" + path + "': " + msg;
         return false;
@@ -59,28 +179,14 @@ bool writeImageAtomic(const std::string &path, const char *format, const ImageSp
     // across runs, so CI can diff them).
     ImageSpec stamped = spec;
     if (!stamped.find_attribute("DateTime")) stamped.attribute("DateTime", "");
-    // Compression tuned for speed: writing the images took longer than the whole analysis at
-    // 1920x1080 (issue 8). Measured per 1080p image of the benchmark (bench/run.sh) with
-    // OpenImageIO 2.4 and zlib 1.2.13:
-    // - PNG (flat-colored visualizations: most rows repeat the row above): the "up" filter turns
-    //   that into runs of zeros, and zlib's run-length strategy codes runs without searching for
-    //   matches; 10 ms instead of 45 ms (libpng tries all five filters per row, zlib level 6
-    //   searches), files 2-60% larger (20-40 KB each).
-    // - OpenEXR: zip at level 1 instead of OpenEXR's default; 8 ms instead of 14-24 ms, files
-    //   13-23% larger. Lossless either way, and deterministic: the same bytes on every run.
-    if (!stamped.find_attribute("compression")) {
-        if (std::strcmp(format, "png") == 0) {
-            stamped.attribute("compression", "rle");
-            stamped.attribute("png:filter", 0x20);  // libpng's PNG_FILTER_UP
-        } else if (std::strcmp(format, "openexr") == 0) {
-            stamped.attribute("compression", "zip:1");
-        }
-    }
-    auto out = ImageOutput::create(format);
-    if (!out) return fail("no OpenImageIO writer for " + std::string(format) + ": " + OIIO::geterror());
+    // zip at level 1 instead of OpenEXR's default: 8 ms instead of 14-24 ms per 1080p image of the
+    // benchmark (issue 8), files 13-23% larger. Lossless either way, and deterministic.
+    if (!stamped.find_attribute("compression")) stamped.attribute("compression", "zip:1");
+    auto out = ImageOutput::create("openexr");
+    if (!out) return fail("no OpenImageIO writer for openexr: " + OIIO::geterror());
     OIIO::Filesystem::IOVecOutput encoded;
     if (!out->supports("ioproxy") || !out->set_ioproxy(&encoded))
-        return fail("the OpenImageIO " + std::string(format) + " writer cannot write to memory");
+        return fail("the OpenImageIO openexr writer cannot write to memory");
     if (!out->open(path, stamped)) return fail(out->geterror());
     if (!out->write_image(spec.format, pixels)) {
         const std::string msg = out->geterror();
@@ -89,12 +195,7 @@ bool writeImageAtomic(const std::string &path, const char *format, const ImageSp
     }
     if (!out->close()) return fail(out->geterror());
     const std::vector<unsigned char> &bytes = encoded.buffer();
-    std::string e;
-    if (!writeFileAtomic(path, std::string(bytes.begin(), bytes.end()), &e)) {
-        const std::string own = "cannot write '" + path + "': ";  // writeFileAtomic's prefix
-        return fail(e.rfind(own, 0) == 0 ? e.substr(own.size()) : e);
-    }
-    return true;
+    return writeEncoded(path, std::string(bytes.begin(), bytes.end()), err);
 }
 
 // ---- Overdraw legend layout -------------------------------------------------------------------
@@ -140,14 +241,14 @@ LegendLayout legendLayout(const std::vector<uint32_t> &values, int imageWidth) {
 }  // namespace
 
 bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err) {
-    return writeImageAtomic(path, "png", ImageSpec(width, height, 3, TypeDesc::UINT8), rgb, err);
+    return writePng(path, width, height, 3, rgb, err);
 }
 
 bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
                     std::string *err) {
     ImageSpec spec(width, height, 1, TypeDesc::UINT32);
     spec.channelnames = {channel};
-    return writeImageAtomic(path, "openexr", spec, values, err);
+    return writeExr(path, spec, values, err);
 }
 
 // ---- Color mappings ---------------------------------------------------------------------------
@@ -238,14 +339,12 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
         ImageSpec spec(W, H, 1, TypeDesc::FLOAT);
         spec.channelnames = {"Z"};
         spec.z_channel = 0;
-        if (!writeImageAtomic(prefix + names.depthExr, "openexr", spec, z.data(), err)) return false;
+        if (!writeExr(prefix + names.depthExr, spec, z.data(), err)) return false;
     }
 
     // BASE.depth.png: log-scaled gray between the view's nearest and farthest finite depth.
     if (want("depth_png")) {
-        ImageSpec spec(W, H, 1, TypeDesc::UINT8);
-        spec.channelnames = {"Y"};
-        if (!writeImageAtomic(prefix + names.depthPng, "png", spec, zGrays()->data(), err)) return false;
+        if (!writePng(prefix + names.depthPng, W, H, 1, zGrays()->data(), err)) return false;
     }
 
     // BASE.overdraw.png: heatmap of fragments per pixel, scale capped at max(8, most fragments), with
@@ -284,9 +383,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
             const int lx = xi + (sw - textWidth(label, s)) / 2, ly = top + L.swatchH + 2 * s;
             drawText(rgb.data(), CW, CH, lx, ly, label, {kLegendText.r, kLegendText.g, kLegendText.b}, s);
         }
-        ImageSpec spec(CW, CH, 3, TypeDesc::UINT8);
-        spec.attribute("visaudit:overdraw_cap", int(cap));
-        if (!writeImageAtomic(prefix + names.overdrawPng, "png", spec, rgb.data(), err)) return false;
+        if (!writePng(prefix + names.overdrawPng, CW, CH, 3, rgb.data(), err)) return false;
     }
 
     // BASE.ids.exr: 1 + visible source triangle index as UINT32 (OpenEXR's 32-bit unsigned pixel
@@ -294,7 +391,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     if (want("ids_exr")) {
         ImageSpec spec(W, H, 1, TypeDesc::UINT32);
         spec.channelnames = {"id"};
-        if (!writeImageAtomic(prefix + names.idsExr, "openexr", spec, zb.id.data(), err)) return false;
+        if (!writeExr(prefix + names.idsExr, spec, zb.id.data(), err)) return false;
     }
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).

@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <mutex>
+#include <set>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -25,6 +27,22 @@ namespace fs = std::filesystem;
 namespace {
 
 std::atomic<unsigned> gCounter{0};
+
+// The staging folders of the OutputDirs open in this process (writeFileAtomic writes plainly into
+// them; OutputDir::commit makes them durable as a whole).
+std::mutex gStagingMutex;
+std::set<std::string> gStaging;
+
+bool inStagingFolder(const std::string &path) {
+    const std::string dir = fs::path(path).parent_path().string();
+    std::lock_guard<std::mutex> lock(gStagingMutex);
+    return gStaging.count(dir) > 0;
+}
+void setStaging(const std::string &dir, bool open) {
+    std::lock_guard<std::mutex> lock(gStagingMutex);
+    if (open) gStaging.insert(dir);
+    else gStaging.erase(dir);
+}
 
 std::string errnoText(int e) { return std::strerror(e); }
 
@@ -54,6 +72,9 @@ bool replaceable(const std::string &dir, std::string *why) {
     if (fs::is_regular_file(fs::path(dir) / "report.json", ec)) return true;
     if (fs::is_regular_file(fs::path(dir) / "pvs-audit.json", ec)) return true;
     if (fs::is_regular_file(fs::path(dir) / "diff.json", ec)) return true;  // visaudit diff's folder
+    // An assignment kit, its answers, a student's grade, a class's grades.
+    for (const char *marker : {"assignment.json", "answers.json", "grade.json", "grades.csv"})
+        if (fs::is_regular_file(fs::path(dir) / marker, ec)) return true;
     *why = "refusing to replace '" + dir +
            "': it is not empty and holds no report.json, so it is not a visaudit report folder; "
            "choose another --out folder (or an empty one)";
@@ -101,6 +122,26 @@ bool writeFileAtomic(const std::string &path, const std::string &contents, std::
         }
         return true;
     }
+    if (inStagingFolder(path)) {
+        // Plainly (see report.h): a failed write leaves a partial file in a folder that is never
+        // committed.
+        const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+        if (fd < 0) {
+            if (err) *err = "cannot write '" + path + "': create: " + errnoText(errno);
+            return false;
+        }
+        if (!writeAll(fd, contents)) {
+            const int e = errno;
+            ::close(fd);
+            if (err) *err = "cannot write '" + path + "': write: " + errnoText(e);
+            return false;
+        }
+        if (::close(fd) != 0) {
+            if (err) *err = "cannot write '" + path + "': close: " + errnoText(errno);
+            return false;
+        }
+        return true;
+    }
     const std::string tmp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(gCounter.fetch_add(1));
     auto fail = [&](const std::string &what, int e, bool removeTmp) {
         if (removeTmp) ::unlink(tmp.c_str());
@@ -129,6 +170,7 @@ bool writeFileAtomic(const std::string &path, const std::string &contents, std::
 bool OutputDir::open(const std::string &target, std::string *err) {
     // A second open() abandons the first staging folder.
     if (!committed_ && !staging_.empty()) {
+        setStaging(staging_, false);
         std::error_code ec;
         fs::remove_all(staging_, ec);
     }
@@ -177,6 +219,7 @@ bool OutputDir::open(const std::string &target, std::string *err) {
         return false;
     }
     staging_ = staging;
+    setStaging(staging_, true);
     return true;
 }
 
@@ -186,6 +229,19 @@ bool OutputDir::commit(std::string *err) {
                                    : "output folder was not opened (call open() first)";
         return false;
     }
+    // Every file in the staging folder reaches the disk before the folder becomes the report: one
+    // syncfs for the file system (a journal commit), then the folder's own entries.
+    {
+        const int fd = ::open(staging_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (fd < 0 || ::syncfs(fd) != 0 || ::fsync(fd) != 0) {
+            const int e = errno;
+            if (fd >= 0) ::close(fd);
+            if (err) *err = "cannot flush staging folder '" + staging_ + "' to disk: " + errnoText(e);
+            return false;
+        }
+        ::close(fd);
+    }
+    setStaging(staging_, false);
     // Check the target again: it may have changed since open().
     std::string old;
     struct stat st;
@@ -233,6 +289,7 @@ bool OutputDir::commit(std::string *err) {
 }
 
 OutputDir::~OutputDir() {
+    if (!staging_.empty()) setStaging(staging_, false);
     if (!committed_ && !staging_.empty()) {
         std::error_code ec;
         fs::remove_all(staging_, ec);

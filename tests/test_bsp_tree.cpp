@@ -147,6 +147,51 @@ TEST(BspTree, Orient3dAgreesWithCgal) {
     EXPECT_GT(decided, 5000);  // many exact zeros: the stages before CGAL were exercised
 }
 
+// PlaneSide gives orient3d's sign for every point: on axis-aligned planes (its comparison path:
+// level brushes) and general ones (its filter, then orient3d), at wide magnitudes, with points on,
+// one ulp off and far from the plane, and for degenerate (collinear) triangles.
+TEST(BspTree, PlaneSideAgreesWithOrient3d) {
+    uint64_t state = 11;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    };
+    int axisPlanes = 0, zeros = 0, offByUlp = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const double scale = std::ldexp(1.0, int(next() * 60) - 30);  // 2^-30 .. 2^30
+        auto coord = [&] { return (next() * 2 - 1) * scale; };
+        Vec3 a{coord(), coord(), coord()}, b{coord(), coord(), coord()}, c{coord(), coord(), coord()};
+        const int axis = i % 4;  // 3: a general plane
+        if (axis < 3) {
+            b[axis] = c[axis] = a[axis];
+            ++axisPlanes;
+        }
+        if (i % 17 == 0) c = a + (b - a) * 2.0;  // collinear (up to rounding)
+        const PlaneSide side(a, b, c);
+        for (int j = 0; j < 8; ++j) {
+            Vec3 d;
+            switch (j % 4) {
+            case 0: d = {coord(), coord(), coord()}; break;
+            case 1: d = a + (b - a) * next() + (c - a) * next(); break;  // on the plane up to rounding
+            case 2: d = j < 4 ? b : c; break;
+            default: {
+                d = a + (b - a) * next() + (c - a) * next();
+                const int k = axis < 3 ? axis : int(next() * 3);
+                d[k] = std::nextafter(axis < 3 ? a[k] : d[k], next() < 0.5 ? -INFINITY : INFINITY);
+                break;
+            }
+            }
+            const int want = orient3d(a, b, c, d);
+            ASSERT_EQ(side(d), want) << "triangle " << i << ", point " << j;
+            zeros += want == 0;
+            offByUlp += j % 4 == 3 && want != 0;
+        }
+    }
+    EXPECT_EQ(axisPlanes, 15000);
+    EXPECT_GT(zeros, 20000);     // points on planes: the exact stages were reached
+    EXPECT_GT(offByUlp, 10000);  // one ulp off a plane: the signs the filter must not guess
+}
+
 TEST(BspTree, EmptyAndSingle) {
     const Scene empty = looseTriangles({});
     const BspTree t0 = buildBspTree(empty);

@@ -213,7 +213,7 @@ TEST(OutputDir, AbandonedLeavesOldReportAndNoStaging) {
     EXPECT_EQ(list(root.path), std::vector<std::string>{"out"});
 }
 
-TEST(OutputDir, FailedCommitRestoresOldReport) {
+TEST(OutputDir, FailedCommitKeepsOldReport) {
     TempRoot root;
     const std::string target = root.path + "/out";
     fs::create_directory(target);
@@ -221,15 +221,35 @@ TEST(OutputDir, FailedCommitRestoresOldReport) {
     OutputDir out;
     std::string err;
     ASSERT_TRUE(out.open(target, &err)) << err;
-    // Make the swap fail: the staging folder disappears before commit (the old report has already
-    // been moved aside when the rename of the staging folder fails).
+    // Make the commit fail: the staging folder disappears before it. Its files are flushed to
+    // disk before anything is swapped, so that fails first and the old report is never touched.
     const std::string staging = out.staging();
     fs::remove_all(staging);
     EXPECT_FALSE(out.commit(&err));
-    EXPECT_TRUE(contains(err, "cannot move staging folder '" + staging + "' to '" + target + "': No such file or directory"))
-        << err;
+    EXPECT_EQ(err, "cannot flush staging folder '" + staging + "' to disk: No such file or directory");
     EXPECT_EQ(readFile(target + "/report.json"), "old");
-    EXPECT_EQ(list(root.path), std::vector<std::string>{"out"});  // the .old folder was moved back
+    EXPECT_EQ(list(root.path), std::vector<std::string>{"out"});
+}
+
+// A file written into an open staging folder is written plainly, in place (a hard link to it
+// sees the new contents), one written anywhere else atomically (a new file renamed over it: the
+// link keeps the old contents); after the commit the folder is an ordinary folder again.
+TEST(OutputDir, StagingFilesAreWrittenInPlace) {
+    TempRoot root;
+    OutputDir out;
+    std::string err;
+    ASSERT_TRUE(out.open(root.path + "/out", &err)) << err;
+    writeFile(out.staging() + "/a.txt", "old");
+    fs::create_hard_link(out.staging() + "/a.txt", root.path + "/link-a");
+    ASSERT_TRUE(writeFileAtomic(out.staging() + "/a.txt", "staged", &err)) << err;
+    EXPECT_EQ(readFile(root.path + "/link-a"), "staged");
+    ASSERT_TRUE(out.commit(&err)) << err;
+    EXPECT_EQ(readFile(root.path + "/out/a.txt"), "staged");
+    fs::create_hard_link(root.path + "/out/a.txt", root.path + "/link-b");
+    ASSERT_TRUE(writeFileAtomic(root.path + "/out/a.txt", "direct", &err)) << err;
+    EXPECT_EQ(readFile(root.path + "/out/a.txt"), "direct");
+    EXPECT_EQ(readFile(root.path + "/link-b"), "staged");
+    EXPECT_EQ(list(root.path + "/out"), std::vector<std::string>{"a.txt"});
 }
 
 TEST(OutputDir, CommitRechecksTheTarget) {

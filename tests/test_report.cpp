@@ -757,6 +757,37 @@ TEST(ReportImages, LargeImageKeepsWidthAndScalesLegend) {
     EXPECT_EQ(rgbAt(o, 1, 0), (Px{32, 64, 255}));
 }
 
+// PNGs with at most 256 colors are stored with a palette (IHDR color type 3), others as RGB
+// (type 2); either reads back as the same RGB pixels. 256 colors is the last palette image, 257
+// the first RGB one; identical rows (copied indices) and colors in scattered order included.
+TEST(ReportImages, PngPaletteUpTo256Colors) {
+    TempDir dir;
+    for (const int colors : {1, 5, 256, 257, 4096}) {
+        const int W = 97, H = 61;
+        std::vector<uint8_t> rgb(size_t(W) * H * 3);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                // Rows 10..19 repeat row 9; colors spread over all channels by a multiplicative hash.
+                const int yy = (y >= 10 && y < 20) ? 9 : y;
+                const uint32_t c = uint32_t((yy * W + x) * 2654435761u % uint32_t(colors)) * 40503u;
+                uint8_t *p = &rgb[(size_t(y) * W + x) * 3];
+                p[0] = uint8_t(c), p[1] = uint8_t(c >> 8), p[2] = uint8_t(c >> 16);
+            }
+        const std::string path = dir.path + "/c" + std::to_string(colors) + ".png";
+        std::string err;
+        ASSERT_TRUE(writePngRgb8(path, W, H, rgb.data(), &err)) << err;
+        const std::string bytes = fileBytes(path);
+        ASSERT_GT(bytes.size(), 26u);
+        EXPECT_EQ(int(uint8_t(bytes[25])), colors <= 256 ? 3 : 2) << colors << " colors";
+        ImageData d;
+        ASSERT_TRUE(readImage(path, &d, &err)) << err;
+        ASSERT_EQ(d.channels(), 3);
+        EXPECT_EQ(d.width, W);
+        EXPECT_EQ(d.height, H);
+        EXPECT_TRUE(d.u8 == rgb) << colors << " colors: pixels differ after reading back";
+    }
+}
+
 TEST(ReportImages, Errors) {
     TempDir dir;
     std::string err;

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <limits>
 
+#include <tbb/parallel_for.h>
+
 #include "render/stopwatch.h"
 
 namespace va {
@@ -18,6 +20,10 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 constexpr uint32_t kInputVertex = std::numeric_limits<uint32_t>::max();
 
 K::Point_3 P(Vec3 v) { return K::Point_3(v.x, v.y, v.z); }
+
+// Candidate scorings (candidates x sampled pieces) from which a node scores its candidates in
+// parallel: below, a task costs more than it saves.
+constexpr size_t kParallelScoring = 1024;
 
 // Side of a piece with respect to a plane.
 enum Side : uint8_t { kCoplanar, kFront, kBack, kStraddle };
@@ -33,14 +39,15 @@ struct Builder {
 
     // Exact side of tree vertex v against the plane of source triangle s used at node `node`:
     // a vertex made by that node's split is on it by construction.
-    int vertexSide(uint32_t v, uint32_t s, uint32_t node, const Vec3 abc[3]) {
+    int vertexSide(uint32_t v, uint32_t node, const PlaneSide &plane, uint64_t &count) const {
         if (vertexTag[v] == node) return 0;
-        ++predicates;
-        return orient3d(abc[0], abc[1], abc[2], tree.vertices[v]);
+        ++count;
+        return plane(tree.vertices[v]);
     }
 
     // Classifies piece p against the plane of source s (node `node`), sides per vertex into `sides`.
-    Side classify(uint32_t p, uint32_t s, uint32_t node, const Vec3 abc[3], int *sides) {
+    // `count` adds the predicates evaluated (BspStats::predicateCalls).
+    Side classify(uint32_t p, uint32_t s, uint32_t node, const PlaneSide &plane, int *sides, uint64_t &count) const {
         const BspPiece &pc = tree.pieces[p];
         if (pc.source == s) return kCoplanar;
         // A split piece: coplanarity is decided on its source's input vertices (exact), not on its
@@ -48,14 +55,14 @@ struct Builder {
         if (pc.constraintCount) {
             bool allOn = true;
             for (int i = 0; i < 3 && allOn; ++i) {
-                ++predicates;
-                allOn = orient3d(abc[0], abc[1], abc[2], sourceVertex(pc.source, i)) == 0;
+                ++count;
+                allOn = plane(sourceVertex(pc.source, i)) == 0;
             }
             if (allOn) return kCoplanar;
         }
         bool front = false, back = false;
         for (uint32_t i = 0; i < pc.vertexCount; ++i) {
-            const int sd = vertexSide(pc.firstVertex + i, s, node, abc);
+            const int sd = vertexSide(pc.firstVertex + i, node, plane, count);
             if (sides) sides[i] = sd;
             front |= sd > 0;
             back |= sd < 0;
@@ -136,26 +143,37 @@ struct Builder {
         const size_t k = settings.candidates == 0 ? n : std::min<size_t>(settings.candidates, n);
         if (k <= 1) return list[0];
         const size_t m = settings.scoreSample == 0 ? n : std::min<size_t>(settings.scoreSample, n);
-        double best = std::numeric_limits<double>::infinity();
-        uint32_t bestPiece = list[0];
-        for (size_t c = 0; c < k; ++c) {
+        // The candidates are scored independently (in parallel when there is enough work: the
+        // nodes near the root), then the first with the lowest score wins, as in a serial loop.
+        std::vector<double> score(k);
+        std::vector<uint64_t> count(k, 0);
+        auto scoreCandidate = [&](size_t c) {
             const uint32_t cand = list[(c * n) / k];
             Vec3 abc[3];
             source3(tree.pieces[cand].source, abc);
+            const PlaneSide plane(abc[0], abc[1], abc[2]);
             uint64_t front = 0, back = 0, splits = 0;
             for (size_t j = 0; j < m; ++j) {
-                switch (classify(list[(j * n) / m], tree.pieces[cand].source, node, abc, nullptr)) {
+                switch (classify(list[(j * n) / m], tree.pieces[cand].source, node, plane, nullptr, count[c])) {
                     case kFront: ++front; break;
                     case kBack: ++back; break;
                     case kStraddle: ++splits; ++front; ++back; break;
                     default: break;
                 }
             }
-            const double score = settings.splitWeight * double(splits) +
-                                 settings.balanceWeight * std::fabs(double(front) - double(back));
-            if (score < best) {
-                best = score;
-                bestPiece = cand;
+            score[c] = settings.splitWeight * double(splits) + settings.balanceWeight * std::fabs(double(front) - double(back));
+        };
+        if (k * m >= kParallelScoring)
+            tbb::parallel_for(size_t(0), k, scoreCandidate);
+        else
+            for (size_t c = 0; c < k; ++c) scoreCandidate(c);
+        double best = std::numeric_limits<double>::infinity();
+        uint32_t bestPiece = list[0];
+        for (size_t c = 0; c < k; ++c) {
+            predicates += count[c];
+            if (score[c] < best) {
+                best = score[c];
+                bestPiece = list[(c * n) / k];
             }
         }
         return bestPiece;
@@ -189,12 +207,13 @@ struct Builder {
             const uint32_t s = tree.pieces[splitter].source;
             Vec3 abc[3];
             source3(s, abc);
+            const PlaneSide plane(abc[0], abc[1], abc[2]);
             tree.nodes[node].planeSource = s;
             tree.nodes[node].firstPiece = uint32_t(tree.nodePieces.size());
             std::vector<uint32_t> front, back;
             for (uint32_t p : w.list) {
                 sides.assign(tree.pieces[p].vertexCount, 0);
-                switch (classify(p, s, node, abc, sides.data())) {
+                switch (classify(p, s, node, plane, sides.data(), predicates)) {
                     case kCoplanar: tree.nodePieces.push_back(p); break;
                     case kFront: front.push_back(p); break;
                     case kBack: back.push_back(p); break;
@@ -308,6 +327,39 @@ int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     // the side the counter-clockwise normal of (p, q, r) points to; tested in BspTree.Orient3d*).
     const CGAL::Orientation o = CGAL::orientation(P(a), P(b), P(c), P(d));
     return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+}
+
+PlaneSide::PlaneSide(Vec3 a, Vec3 b, Vec3 c) : a_(a), b_(b), c_(c) {
+    for (int k = 0; k < 3 && axis_ < 0; ++k)
+        if (a[k] == b[k] && a[k] == c[k]) axis_ = k;
+    if (axis_ >= 0) {
+        // det[b - a, c - a, d - a] with the axis column of the first two rows exactly zero is
+        // (d - a)[axis] times the cofactor of that entry; its sign is orient3d's at a point just
+        // beyond a on the axis (the next double up: d - a > 0 exactly there).
+        Vec3 e = a;
+        e[axis_] = std::nextafter(a[axis_], std::numeric_limits<double>::infinity());
+        axisSign_ = orient3d(a, b, c, e);
+        return;
+    }
+    // orient3d's stage A with r3 = d - a outside and the minors of r1 = b - a, r2 = c - a: the
+    // same expansion along another row, so the same bound, (7 + 56 eps) eps * permanent.
+    const double r1x = b.x - a.x, r1y = b.y - a.y, r1z = b.z - a.z;
+    const double r2x = c.x - a.x, r2y = c.y - a.y, r2z = c.z - a.z;
+    const double p1 = r1y * r2z, p2 = r1z * r2y, p3 = r1z * r2x, p4 = r1x * r2z, p5 = r1x * r2y, p6 = r1y * r2x;
+    n_[0] = p1 - p2, n_[1] = p3 - p4, n_[2] = p5 - p6;
+    m_[0] = std::fabs(p1) + std::fabs(p2), m_[1] = std::fabs(p3) + std::fabs(p4), m_[2] = std::fabs(p5) + std::fabs(p6);
+}
+
+int PlaneSide::operator()(Vec3 d) const {
+    if (axis_ >= 0) return axisSign_ * ((d[axis_] > a_[axis_]) - (d[axis_] < a_[axis_]));
+    const double r3x = d.x - a_.x, r3y = d.y - a_.y, r3z = d.z - a_.z;
+    const double det = r3x * n_[0] + r3y * n_[1] + r3z * n_[2];
+    const double permanent = std::fabs(r3x) * m_[0] + std::fabs(r3y) * m_[1] + std::fabs(r3z) * m_[2];
+    constexpr double eps = 0x1p-53;
+    const double bound = (7.0 + 56.0 * eps) * eps * permanent;
+    if (det > bound) return 1;
+    if (det < -bound) return -1;
+    return orient3d(a_, b_, c_, d);
 }
 
 BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles, const BspSettings &settings) {

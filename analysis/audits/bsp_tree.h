@@ -32,6 +32,25 @@ namespace va {
 // CGAL's orientation predicate (Exact_predicates_inexact_constructions_kernel).
 int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d);
 
+// orient3d(a, b, c, d) for many points d against one plane: the same exact sign, with the work that
+// depends on the plane alone done once. A plane whose three points share one coordinate exactly
+// (an axis-aligned face: most faces of a brush-built level) decides by comparing that coordinate
+// (the determinant is (d - a) on that axis times a fixed cofactor, whose exact sign orient3d gives
+// once); any other runs orient3d's static filter with the plane's minors and their magnitudes
+// precomputed, and orient3d itself only where the filter cannot tell.
+class PlaneSide {
+public:
+    PlaneSide(Vec3 a, Vec3 b, Vec3 c);
+    int operator()(Vec3 d) const;
+
+private:
+    Vec3 a_, b_, c_;
+    int axis_ = -1;        // 0, 1, 2: a, b and c share that coordinate; -1: none
+    int axisSign_ = 0;     // the sign for a point beyond a on that axis (0: a degenerate triangle)
+    double n_[3] = {};     // (b - a) x (c - a), rounded as orient3d's filter rounds its minors
+    double m_[3] = {};     // per component, the sum of its two products' magnitudes (the permanent's)
+};
+
 // Splitter choice (a stated heuristic, Thibault & Naylor / Fuchs' "least splits" family): at each
 // node, `candidates` pieces spread evenly over the node's list are tried as the splitting plane
 // (0 = every piece), each scored over `scoreSample` pieces spread evenly over the list (0 = all) as

@@ -161,20 +161,30 @@ const char *painterKeyName(PainterKey k) {
     return "?";
 }
 
-std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
+std::vector<PainterCandidate> painterCandidates(const OrderingView &v) {
     const Scene &scene = *v.scene;
-    std::vector<std::pair<double, uint32_t>> keyed;
+    std::vector<PainterCandidate> out;
     for (uint32_t s = 0; s < scene.triangleCount(); ++s) {
         if (v.screenEnd[s] == v.screenBegin[s]) continue;
-        const double d0 = viewDepth(v.cam, vertexOf(scene, s, 0)), d1 = viewDepth(v.cam, vertexOf(scene, s, 1)),
-                     d2 = viewDepth(v.cam, vertexOf(scene, s, 2));
+        out.push_back({s,
+                       {viewDepth(v.cam, vertexOf(scene, s, 0)), viewDepth(v.cam, vertexOf(scene, s, 1)),
+                        viewDepth(v.cam, vertexOf(scene, s, 2))}});
+    }
+    return out;
+}
+
+std::vector<uint32_t> painterOrder(const std::vector<PainterCandidate> &candidates, PainterKey key) {
+    std::vector<std::pair<double, uint32_t>> keyed;
+    keyed.reserve(candidates.size());
+    for (const PainterCandidate &c : candidates) {
+        const double d0 = c.depth[0], d1 = c.depth[1], d2 = c.depth[2];
         double k = 0;
         switch (key) {
             case PainterKey::centroid: k = (d0 + d1 + d2) / 3; break;  // depth is affine: the centroid's depth
             case PainterKey::nearestVertex: k = std::min(d0, std::min(d1, d2)); break;
             case PainterKey::farthestVertex: k = std::max(d0, std::max(d1, d2)); break;
         }
-        keyed.push_back({k, s});
+        keyed.push_back({k, c.source});
     }
     // Back to front: largest key first; equal keys by descending id, so the lowest id is drawn
     // last and shows (the reference's tie rule).
@@ -184,6 +194,10 @@ std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
     std::vector<uint32_t> order(keyed.size());
     for (size_t i = 0; i < keyed.size(); ++i) order[i] = keyed[i].second;
     return order;
+}
+
+std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
+    return painterOrder(painterCandidates(v), key);
 }
 
 namespace {
@@ -481,11 +495,10 @@ bool projectionsDisjoint(const ScreenTriangles &st, uint32_t a0, uint32_t a1, ui
 
 // Every vertex of triangle p on Q's plane or on the side `side` of it (side = +-1: the eye's side,
 // or the side away from it); false when the eye is in Q's plane (side 0).
-bool allOnSide(const Scene &s, uint32_t q, uint32_t p, int side) {
+bool allOnSide(const Scene &s, const PlaneSide &planeOfQ, uint32_t p, int side) {
     if (side == 0) return false;
-    const Vec3 a = vertexOf(s, q, 0), b = vertexOf(s, q, 1), c = vertexOf(s, q, 2);
     for (int i = 0; i < 3; ++i)
-        if (orient3d(a, b, c, vertexOf(s, p, i)) * side < 0) return false;
+        if (planeOfQ(vertexOf(s, p, i)) * side < 0) return false;
     return true;
 }
 
@@ -550,7 +563,11 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
     boxes.reserve(n);
     for (const PairTri &t : tris) boxes.emplace_back(CGAL::Bbox_3(t.bx0, t.by0, t.zmin, t.bx1, t.by1, t.zmax), &t);
     uint64_t boundsOverlap = 0;
-    // The eye's side of each drawn triangle's plane, once per triangle instead of once per pair.
+    // Per drawn triangle (as tris), its plane's side test and the eye's side of it, once per
+    // triangle instead of once per pair.
+    std::vector<PlaneSide> planeOf;
+    planeOf.reserve(n);
+    for (const PairTri &t : tris) planeOf.emplace_back(vertexOf(scene, t.src, 0), vertexOf(scene, t.src, 1), vertexOf(scene, t.src, 2));
     std::vector<int8_t> eyeSideOf(scene.triangleCount(), 0);
     for (const PairTri &t : tris) eyeSideOf[t.src] = int8_t(eyeSide(scene, v.cam, t.src));
     auto classify = [&](const Box &a, const Box &b) {
@@ -559,17 +576,18 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
         const PairTri &Pt = A.rank < B.rank ? A : B;  // drawn first: the farther by the sort
         const PairTri &Qt = A.rank < B.rank ? B : A;
         const uint32_t P = Pt.src, Q = Qt.src;
+        const PlaneSide &planeP = planeOf[size_t(&Pt - tris.data())], &planeQ = planeOf[size_t(&Qt - tris.data())];
         const int eyeQ = eyeSideOf[Q], eyeP = eyeSideOf[P];
-        if (allOnSide(scene, Q, P, -eyeQ)) {
+        if (allOnSide(scene, planeQ, P, -eyeQ)) {
             ++r.behindPlane;
-        } else if (allOnSide(scene, P, Q, eyeP)) {
+        } else if (allOnSide(scene, planeP, Q, eyeP)) {
             ++r.inFrontOfPlane;
         } else if (projectionsDisjoint(v.all, v.screenBegin[P], v.screenEnd[P], v.screenBegin[Q], v.screenEnd[Q])) {
             ++r.projectionsDisjoint;
-        } else if (allOnSide(scene, P, Q, -eyeP)) {  // Newell's swap: Q is the farther one
+        } else if (allOnSide(scene, planeP, Q, -eyeP)) {  // Newell's swap: Q is the farther one
             ++r.behindPlane;
             ++r.swapped;
-        } else if (allOnSide(scene, Q, P, eyeQ)) {
+        } else if (allOnSide(scene, planeQ, P, eyeQ)) {
             ++r.inFrontOfPlane;
             ++r.swapped;
         } else {

@@ -127,6 +127,19 @@ PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility
 // triangles. O(n log n).
 std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key);
 
+// What the sort reads of one source triangle: the view depth d = -z_view of each of its unclipped
+// world vertices (dot(vertex - eye, forward)). An assignment kit's painter input (analysis/kit.h).
+struct PainterCandidate {
+    uint32_t source = 0;
+    double depth[3] = {0, 0, 0};
+};
+// The candidates of painterOrder(v, key): the source triangles with screen triangles, ascending.
+std::vector<PainterCandidate> painterCandidates(const OrderingView &v);
+// The sort itself: keys from the depths (centroid: (d0 + d1 + d2) / 3; nearest: the least; farthest:
+// the greatest), largest key first, equal keys by descending id. painterOrder(v, key) is
+// painterOrder(painterCandidates(v), key).
+std::vector<uint32_t> painterOrder(const std::vector<PainterCandidate> &candidates, PainterKey key);
+
 // ---- Draw orders and overdraw -------------------------------------------------------------------
 
 // One drawn item: a whole source triangle, or one piece of it from a BSP tree (its fragments are
