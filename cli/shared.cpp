@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include "analysis/load/demo.h"
+#include "analysis/level_samples.h"
 #include "analysis/load/level_views.h"
 #include "analysis/load/load.h"
 #include "cli/commands.h"
@@ -80,7 +81,11 @@ bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *view
     // Whatever a loader dropped or ignored is said, even with --quiet (it changes what is analysed).
     for (const std::string &w : scene->warnings) std::fprintf(stderr, "visaudit: warning: %s\n", w.c_str());
     bool handled = false;
-    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err, o.eyeHeight)) {
+    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err)) {
+        fail(err);
+        return false;
+    }
+    if (!handled && !o.views.empty() && !levelSampleViews(o.views, *scene, views, &handled, &err, o.eyeHeight)) {
         fail(err);
         return false;
     }

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/level_map.h"
-#include "analysis/load/level_views.h"
+#include "analysis/level_samples.h"
 #include "reports/level_maps.h"
 #include "tests/temp_dir_test.h"
 

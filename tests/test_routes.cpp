@@ -261,6 +261,11 @@ TEST_F(RouteFileTest, BadRouteFilesAreRefusedWithTheFileThePlaceAndAFix) {
     EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0, \"pitch\": 90}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}"),
               file() + ":1:84: keyframes[0].pitch: must be between -90 and 90 degrees (exclusive): the elevation above "
                        "the horizon");
+    // Below 90 but too close for the camera model (|forward x up| = cos(pitch) <= 1e-9): refused at
+    // the keyframe, not later at a frame.
+    EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0, \"pitch\": 89.99999999999}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}"),
+              file() + ":1:84: keyframes[0].pitch: looks too nearly along the up axis for a camera; tilt it less "
+                       "(pitch 89.99999999999)");
     EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"target\": [0, 5, 5]}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}"),
               file() + ":1:75: keyframes[0].target: looks straight along the up axis (y); no yaw follows from it: move "
                        "the target sideways");

@@ -305,6 +305,20 @@ bool loadRouteFile(const std::string &path, const Scene &scene, Route *out, std:
                 return failed();
             }
         }
+        // A camera can look this way: the frames' pitch lies between their keyframes', so a
+        // direction the camera model accepts at every keyframe it accepts between them too.
+        {
+            CameraSpec probe;
+            probe.eye = {0, 0, 0};
+            probe.target = routeDirection(route.up, k.yaw, k.pitch);
+            probe.up = load::upVector(route.up);
+            Camera cam;
+            if (!makeCamera(probe, &cam, nullptr)) {
+                r.fail(p / (hasTarget ? "target" : "pitch"),
+                       "looks too nearly along the up axis for a camera; tilt it less (pitch " + numberText(k.pitch) + ")");
+                return failed();
+            }
+        }
         if (j.contains("time")) {
             if (!r.number(j["time"], p / "time", &k.time)) return failed();
             ++timed;
