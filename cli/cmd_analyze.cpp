@@ -263,15 +263,14 @@ int analyzeToReport(const AnalyzeOptions &o,
     const Stopwatch r0;
     *report = reportJson(result, imageSet);
     outputMs.reportMs = r0.ms();
-    // A route's plot (route-NAME.png) and the level maps are images like the views' ones: written
-    // unless --images none.
-    if (imageSet != ImageSet::none) {
-        if (!writeRoutePlots(report, out.staging(), &err) ||
-            (result.floorPlan && (!writeFloorPlanPng(*result.floorPlan, out.staging(), &err) ||
-                                  !writeLevelMapImages(report, out.staging(), &err)))) {
-            fail(err);
-            return kExitBadInput;
-        }
+    // The report's own pictures -- a route's plot (route-NAME.png), the level maps -- are a few
+    // files whatever --images says (it chooses the views' images): a level-map run of thousands of
+    // views writes its maps without a PNG per view.
+    if (!writeRoutePlots(report, out.staging(), &err) ||
+        (result.floorPlan && (!writeFloorPlanPng(*result.floorPlan, out.staging(), &err) ||
+                              !writeLevelMapImages(report, out.staging(), &err)))) {
+        fail(err);
+        return kExitBadInput;
     }
     // A failure to write (disk full, read-only folder) is the output location's problem: exit 2
     // with the path, and the previous report stays as it was. A signal is honoured up to the
@@ -416,8 +415,8 @@ void addAnalyzeOptions(CLI::App *c, AnalyzeOptions &o) {
     addSceneOptions(c, o);
     c->add_option("--out", o.out, "Output folder (written as a whole or not at all)");
     c->add_option("--images", o.images,
-                  "Images written: all (default), key (per view the depth, overdraw, z-fighting and culling PNGs the "
-                  "page shows first), none (numbers only: report.json and report.html)")
+                  "Images written per view: all (default), key (the depth, overdraw, z-fighting and culling PNGs the "
+                  "page shows first), none (numbers only; route plots and level maps are still drawn)")
         ->check(CLI::IsMember({"all", "key", "none"}));
     c->add_option("--level-maps", o.levelMaps,
                   "Top-down level maps of triangles drawn, overdraw, wasted draws and false culls per position: auto "

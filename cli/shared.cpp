@@ -7,6 +7,7 @@
 #include <signal.h>
 
 #include "analysis/load/demo.h"
+#include "analysis/level_samples.h"
 #include "analysis/load/level_views.h"
 #include "analysis/load/load.h"
 #include "cli/commands.h"
@@ -80,7 +81,11 @@ bool loadInputs(const SceneOptions &o, Scene *scene, std::vector<ViewSpec> *view
     // Whatever a loader dropped or ignored is said, even with --quiet (it changes what is analysed).
     for (const std::string &w : scene->warnings) std::fprintf(stderr, "visaudit: warning: %s\n", w.c_str());
     bool handled = false;
-    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err, o.eyeHeight)) {
+    if (!o.views.empty() && !levelViews(o.views, *scene, views, &handled, &err)) {
+        fail(err);
+        return false;
+    }
+    if (!handled && !o.views.empty() && !levelSampleViews(o.views, *scene, views, &handled, &err, o.eyeHeight)) {
         fail(err);
         return false;
     }
@@ -172,7 +177,7 @@ void addSceneOptions(CLI::App *c, SceneOptions &o) {
                                     "none = the built-in demo");
     c->add_option("--views", o.views, "Views: a views file (.json); orbit:N (N cameras around the scene); "
                                       "route:FILE[:N|:Ts] (a route file's keyframes, N frames, or a frame every T "
-                                      "seconds); grid:N[:D] (N positions over the floor plan, D directions each); for a "
+                                      "seconds); grid:N[:D] (N positions over the floor plan, D directions each, default 4); for a "
                                       "Quake 3 map, spawns (its spawn points), walk:N[:SEED] (N points inside its "
                                       "clusters) or clusters[:D] (one position per cluster)");
     c->add_option("--eye-height", o.eyeHeight,

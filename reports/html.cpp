@@ -2,6 +2,8 @@
 //
 // Structure of the page, top to bottom:
 //   header       scene, tool, the verdict (findings.verdict), links to every view
+//   routes       each route's series as a plot, worst frames linked (only with routes)
+//   level maps   the level from above per metric, worst positions linked (only with level maps)
 //   summary      one row per view, worst first (findings.worst_first, each view's findings.score)
 //   planner      the report-level "effects" decisions (when present)
 //   depth audit  depth-audit.png when the folder holds one
@@ -222,9 +224,10 @@ std::string reportHtml(const nlohmann::ordered_json &reportIn, const std::string
          "style-src 'unsafe-inline'; script-src 'unsafe-inline'\">"
          "<title>visaudit: " + esc(scenePath) + "</title><style>" + html_assets::kCss + "</style></head><body>\n";
     w.header();
-    w.summary();
+    // What a level designer reads first: where along the routes and where in the level it costs.
     w.routes();
     w.levelMaps();
+    w.summary();
     w.planner();
     w.quakeMap();
     if (const Json *scene = get(&report, "scene"))

@@ -16,9 +16,11 @@ constexpr const char *kStyle =
     "<style>svg.routeplot .line{fill:none;stroke:var(--accent);stroke-width:1.5}"
     "svg.routeplot .worst{fill:var(--bad)}svg.routeplot .frame{fill:transparent}"
     "svg.routeplot a:hover .frame{fill:var(--accent)}"
-    ".lm-pin{position:absolute;transform:translate(-50%,-50%);min-width:1.4em;padding:0 3px;font:600 11px/1.4 "
-    "system-ui,sans-serif;text-align:center;color:#fff;background:#000c;border:1px solid #fff;border-radius:8px;"
-    "text-decoration:none}.lm-pin:hover{background:var(--bad)}"
+    // A pin is a ring over a numbered position (the number is the image's own): clickable, outlined
+    // on hover and when it is the target.
+    ".lm-pin{position:absolute;transform:translate(-50%,-50%);width:20px;height:20px;border-radius:50%;"
+    "border:2px solid transparent;color:transparent;font-size:0;overflow:hidden}"
+    ".lm-pin:hover,.lm-pin:focus{border-color:var(--mark);box-shadow:0 0 0 2px #000a}"
     ".levelmaps{display:grid;grid-template-columns:repeat(auto-fill,minmax(420px,1fr));gap:14px}</style>";
 
 std::string viewLink(const std::vector<const Json *> &views, size_t pos) {
@@ -185,7 +187,7 @@ void HtmlWriter::levelMaps() {
                             fx(100.0 * (std::floor(numOr(p, {"x"}, 0)) + 0.5) / size->first) + "%;top:" +
                             fx(100.0 * (std::floor(numOr(p, {"y"}, 0)) + 0.5) / size->second) + "%\" title=\"" +
                             esc(pos < views.size() ? str(views[pos], {"name"}) : "") + ": " +
-                            valueText(get(&w, "value"), real) + "\">" + rank + "</a>";
+                            valueText(get(&w, "value"), real) + "\" aria-label=\"worst " + rank + "\">" + rank + "</a>";
                 rows += "<tr><td class=\"n\">" + rank + "</td><td>" + viewLink(views, pos) + "</td><td class=\"n\">" +
                         valueText(get(&w, "value"), real) + "</td></tr>";
             }

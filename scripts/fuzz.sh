@@ -10,7 +10,7 @@
 #       CI's check: N executions per target (default 3000) mutating the small seeds only (no data/,
 #       no saved corpus); exits non-zero on any finding.
 #
-# Targets: scene_json views_json budget_json obj ply off stl gltf glb bsp pk3.
+# Targets: scene_json views_json route_json budget_json obj ply off stl gltf glb bsp pk3.
 # Findings (crash-*, leak-*, timeout-*, oom-*) are copied to fuzz/findings/TARGET/ with the log;
 # each becomes a fix in the loader and a literal case in tests/test_fuzz_regressions.cpp.
 # Needs clang-14 and libclang-rt-14-dev (scripts/install-deps.sh).
@@ -18,7 +18,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 
-ALL=(scene_json views_json budget_json obj ply off stl gltf glb bsp pk3)
+ALL=(scene_json views_json route_json budget_json obj ply off stl gltf glb bsp pk3)
 seconds=600 smoke=0 runs=3000 parallel=1 build="$root/build-fuzz" targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -56,6 +56,7 @@ python3 "$root/fuzz/make_seeds.py" "$seeds/small" "$root/tests/data/tiny.gltf"
 cp "$root"/examples/*.scene.json "$seeds/small/scene_json/"
 cp "$root"/examples/*.views.json "$root"/tests/browser/*.views.json "$seeds/small/views_json/"
 cp "$root"/examples/*.budget.json "$seeds/small/budget_json/"
+cp "$root"/examples/*.route.json "$root"/tests/browser/*.route.json "$seeds/small/route_json/"
 for e in obj ply off stl; do cp "$root"/examples/meshes/*."$e" "$root"/tests/data/*."$e" "$seeds/small/$e/"; done
 cp "$root"/tests/data/*.gltf "$seeds/small/gltf/"
 # Issue 16: a glTF whose extras nest past --max-json-depth (refused before tinygltf parses it).
@@ -68,6 +69,8 @@ python3 -c 'import sys; n = 600; sys.stdout.write("{\"views\":[{\"x\":" + "[" * 
   > "$seeds/small/views_json/deep.views.json"
 python3 -c 'import sys; n = 600; sys.stdout.write("{\"format\":\"visaudit-budget/1\",\"x\":" + "{\"a\":" * n + "1" + "}" * n + "}")' \
   > "$seeds/small/budget_json/deep.budget.json"
+python3 -c 'import sys; n = 600; sys.stdout.write("{\"format\":\"visaudit-route/1\",\"keyframes\":" + "[" * n + "]" * n + "}")' \
+  > "$seeds/small/route_json/deep.route.json"
 cp "$root"/tests/data/fuzz/* "$seeds/small/" 2>/dev/null || true
 if [ -f data/castle/level/level-dungeon.gltf ]; then
   cp data/castle/level/level-dungeon.gltf "$seeds/data/gltf/"
@@ -92,7 +95,7 @@ fi
 
 dict_of() {
   case "$1" in
-    scene_json|views_json|budget_json) echo json ;;
+    scene_json|views_json|route_json|budget_json) echo json ;;
     glb) echo gltf ;;
     *) echo "$1" ;;
   esac

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analysis/level_map.h"
-#include "analysis/load/level_views.h"
+#include "analysis/level_samples.h"
 #include "reports/level_maps.h"
 #include "tests/temp_dir_test.h"
 
@@ -214,7 +214,7 @@ class LevelMapCliTest : public testing_util::TempDirTest {
     }
 };
 
-TEST_F(LevelMapCliTest, GridMapsAreWrittenAndShardsMergeIntoTheSameMaps) {
+TEST_F(LevelMapCliTest, GridMapsAreWrittenDeterministicallyAndShardsMergeIntoTheSameMaps) {
     std::ofstream(dir_ / "level.obj") << "v 0 0 0\nv 16 0 0\nv 16 8 0\nv 0 8 0\nv 4 2 2\nv 6 2 2\nv 6 4 2\nv 4 4 2\n"
                                          "f 1 2 3 4\nf 5 6 7 8\n";
     std::ofstream(dir_ / "level.scene.json")
@@ -223,6 +223,7 @@ TEST_F(LevelMapCliTest, GridMapsAreWrittenAndShardsMergeIntoTheSameMaps) {
     const std::string common = (dir_ / "level.scene.json").string() +
                                " --views grid:6:2 --width 32 --height 18 --map-size 96 --no-ordering --images key --quiet";
     ASSERT_EQ(run("analyze " + common + " --out " + (dir_ / "single").string()), 0) << slurp(dir_ / "err.txt");
+    ASSERT_EQ(run("analyze " + common + " --threads 1 --out " + (dir_ / "one").string()), 0);
     ASSERT_EQ(run("analyze " + common + " --shard 1/2 --out " + (dir_ / "s1").string()), 0);
     ASSERT_EQ(run("analyze " + common + " --shard 2/2 --out " + (dir_ / "s2").string()), 0);
     ASSERT_EQ(run("merge " + (dir_ / "s1").string() + " " + (dir_ / "s2").string() + " --out " + (dir_ / "merged").string() +
@@ -236,10 +237,13 @@ TEST_F(LevelMapCliTest, GridMapsAreWrittenAndShardsMergeIntoTheSameMaps) {
     EXPECT_EQ(single["level_maps"]["positions"].size(), 6u);
     for (const Json &p : single["level_maps"]["positions"]) EXPECT_EQ(p["views"].size(), 2u);
     EXPECT_EQ(merged["level_maps"], single["level_maps"]);
+    EXPECT_EQ(Json::parse(slurp(dir_ / "one" / "report.json"))["level_maps"], single["level_maps"]);
     for (const char *m : {"floor", "triangles_drawn", "overdraw", "wasted_share", "false_cull_pixels"}) {
         const std::string name = std::string("level-map-") + m + ".png";
         ASSERT_TRUE(fs::exists(dir_ / "single" / name)) << name;
         EXPECT_TRUE(slurp(dir_ / "single" / name) == slurp(dir_ / "merged" / name)) << name << " differs";
+        // The same bytes on one thread as on all (the views' results do not depend on it).
+        EXPECT_TRUE(slurp(dir_ / "single" / name) == slurp(dir_ / "one" / name)) << name << " differs on one thread";
     }
     // The page shows the maps with their worst positions linked to the views.
     const std::string html = slurp(dir_ / "single" / "report.html");

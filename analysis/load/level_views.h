@@ -38,27 +38,10 @@ std::vector<ViewSpec> spawnViews(const Scene &scene);
 // Identical for the same scene, n and seed on every platform. Empty without a Quake 3 map.
 std::vector<ViewSpec> walkViews(const Scene &scene, int n, uint64_t seed = 1);
 
-// Views at sample positions covering a level, each position seen in `dirs` directions (yaws 0,
-// 360/dirs, ...; horizontal, as route.h's yaw): the level maps colour each position by the worst
-// of its views (docs/level-maps.md). Positions "gridK" / "clusterK", views "gridK" (one direction)
-// or "gridK-yawD".
-//
-// grid:N -- N positions on a square lattice over the level's floor plan (analysis/level_map.h,
-// rendered from above through the project's rasterizer): lattice points on a surface a player can
-// stand on (|n . up| >= 0.7, Quake 3's MIN_WALK_NORMAL), the eye `eyeHeight` above it; on a Quake 3
-// map only where the eye is inside a cluster. The lattice spacing is the largest that gives at
-// least N such points; when it gives more, N are kept evenly along the raster order. Any scene.
-std::vector<ViewSpec> gridViews(const Scene &scene, int n, int dirs, double eyeHeight, std::string *err);
-// clusters -- one position per cluster of a Quake 3 map: in the cluster's largest leaf (by its
-// horizontal area; the next largest when the eye would leave the cluster's leafs for solid), placed
-// as walk:N places its points.
-std::vector<ViewSpec> clusterViews(const Scene &scene, int dirs);
-
-// Parses a --views value naming level views: "spawns", "walk:N", "walk:N:SEED", "grid:N",
-// "grid:N:D", "clusters", "clusters:D". Returns false with a message when the value is malformed or
-// the scene cannot give such views (not a map, no spawn points, no clusters). `handled` is false
-// (and nothing else happens) for other values. `eyeHeight` (grid:N) 0: the scene's default.
+// Parses a --views value naming level views: "spawns", "walk:N" or "walk:N:SEED". Returns false
+// with a message when the value is malformed or the scene cannot give such views (not a map, no
+// spawn points, no clusters). `handled` is false (and nothing else happens) for other values.
 bool levelViews(const std::string &spec, const Scene &scene, std::vector<ViewSpec> *out, bool *handled,
-                std::string *err, double eyeHeight = 0);
+                std::string *err);
 
 }  // namespace va

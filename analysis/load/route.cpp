@@ -305,6 +305,20 @@ bool loadRouteFile(const std::string &path, const Scene &scene, Route *out, std:
                 return failed();
             }
         }
+        // A camera can look this way: the frames' pitch lies between their keyframes', so a
+        // direction the camera model accepts at every keyframe it accepts between them too.
+        {
+            CameraSpec probe;
+            probe.eye = {0, 0, 0};
+            probe.target = routeDirection(route.up, k.yaw, k.pitch);
+            probe.up = load::upVector(route.up);
+            Camera cam;
+            if (!makeCamera(probe, &cam, nullptr)) {
+                r.fail(p / (hasTarget ? "target" : "pitch"),
+                       "looks too nearly along the up axis for a camera; tilt it less (pitch " + numberText(k.pitch) + ")");
+                return failed();
+            }
+        }
         if (j.contains("time")) {
             if (!r.number(j["time"], p / "time", &k.time)) return failed();
             ++timed;
@@ -360,6 +374,64 @@ bool loadRouteFile(const std::string &path, const Scene &scene, Route *out, std:
     return true;
 }
 
+bool spawnRoute(const Scene &scene, Route *out, std::string *err) {
+    if (!scene.bsp) {
+        *err = "'" + scene.path + "' is not a Quake 3 map; route:spawns walks a map's spawn points (write a route file instead)";
+        return false;
+    }
+    std::vector<ViewSpec> spawns;
+    for (const ViewSpec &v : spawnViews(scene))
+        if (v.name.rfind("spawn", 0) == 0) spawns.push_back(v);
+    if (spawns.size() < 2) {
+        *err = "'" + scene.path + "' has " + std::to_string(spawns.size()) +
+               " spawn points; a route needs at least 2 (write a route file instead)";
+        return false;
+    }
+    // Nearest neighbour from the first spawn point (ties: entity order): fewer walls crossed than in
+    // entity order, deterministic.
+    std::vector<size_t> order = {0};
+    std::vector<bool> used(spawns.size(), false);
+    used[0] = true;
+    for (size_t step = 1; step < spawns.size(); ++step) {
+        const Vec3 at = spawns[order.back()].camera.eye;
+        size_t best = 0;
+        double bestD = INFINITY;
+        for (size_t k = 0; k < spawns.size(); ++k)
+            if (!used[k] && length(spawns[k].camera.eye - at) < bestD) bestD = length(spawns[k].camera.eye - at), best = k;
+        used[best] = true;
+        order.push_back(best);
+    }
+    Route r;
+    r.name = "spawns";
+    r.file = "spawns";
+    r.up = scene.up;
+    r.interpolation = RouteInterpolation::linear;
+    r.speed = kQuakeRunSpeed;
+    r.camera = quakeCamera(scene, {0, 0, 0}, 0);
+    r.quakeCamera = true;
+    double t = 0;
+    for (size_t i = 0; i < order.size(); ++i) {
+        const ViewSpec &v = spawns[order[i]];
+        RouteKeyframe k;
+        k.eye = v.camera.eye;
+        if (!yawPitchOf(scene.up, v.camera.target - v.camera.eye, &k.yaw, &k.pitch)) k.yaw = 0, k.pitch = 0;
+        if (i > 0) {
+            const double step = length(k.eye - r.keyframes.back().eye) / r.speed;
+            if (!(step > 0)) continue;  // two spawn points at one place: one keyframe
+            t += step;
+        }
+        k.time = t;
+        r.length += i > 0 ? length(k.eye - r.keyframes.back().eye) : 0;
+        r.keyframes.push_back(k);
+    }
+    if (r.keyframes.size() < 2) {
+        *err = "'" + scene.path + "' has its spawn points at one place; write a route file instead";
+        return false;
+    }
+    *out = std::move(r);
+    return true;
+}
+
 namespace {
 
 // "12" -> count 12; "0.5s" -> every 0.5 s. False when the text is neither.
@@ -408,7 +480,14 @@ bool routeViewsFromSpec(const std::string &spec, const Scene &scene, uint64_t ma
         return false;
     }
     Route r;
-    if (!loadRouteFile(file, scene, &r, err, maxJsonDepth)) return false;
+    if (file == "spawns" && !std::filesystem::exists(file)) {
+        if (!spawnRoute(scene, &r, err)) {
+            *err = "--views " + spec + ": " + *err;
+            return false;
+        }
+    } else if (!loadRouteFile(file, scene, &r, err, maxJsonDepth)) {
+        return false;
+    }
     r.sampling = sampling;
     if (sampling.kind == RouteSampling::Kind::every) {
         const double frames = std::floor(r.duration() / sampling.every) + 1;

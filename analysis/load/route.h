@@ -92,7 +92,17 @@ std::vector<ViewSpec> routeViews(const Route &route);
 bool loadRouteFile(const std::string &path, const Scene &scene, Route *out, std::string *err,
                    uint64_t maxJsonDepth = kDefaultMaxJsonDepth);
 
-// A --views value naming a route: "route:FILE", "route:FILE:N", "route:FILE:Ts". `handled` is
+// Quake 3's run speed (g_speed, units per second): route:spawns moves at it.
+constexpr double kQuakeRunSpeed = 320;
+// route:spawns -- a Quake 3 map's spawn points (info_player_*, team_CTF_*; not the intermissions)
+// as a route: straight lines at the run speed, from the first spawn point to the nearest one not
+// yet visited, and so on; each keyframe faces its spawn point's angle. The lines may pass through
+// walls (frames there see the void): for a real path, write a route file. False + message on a
+// scene that is not a map or has fewer than 2 spawn points.
+bool spawnRoute(const Scene &scene, Route *out, std::string *err);
+
+// A --views value naming a route: "route:FILE", "route:FILE:N", "route:FILE:Ts", or
+// "route:spawns[:N|:Ts]" on a Quake 3 map (unless a file named "spawns" exists). `handled` is
 // false (and nothing else happens) for other values. On success *views holds the frames and
 // *route the route.
 bool routeViewsFromSpec(const std::string &spec, const Scene &scene, uint64_t maxJsonDepth,

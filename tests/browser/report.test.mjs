@@ -2,9 +2,10 @@
 // Debian chromium through playwright-core (no browser download) and fails on anything a reader
 // would see broken.
 //
-//   node report.test.mjs --visaudit BUILD/visaudit --out DIR [--views FILE] [--screenshot FILE.png]
-//       runs `visaudit analyze --out DIR --quiet` (the built-in demo; --views passed on), then
-//       tests DIR/report.html
+//   node report.test.mjs --visaudit BUILD/visaudit --out DIR [--views V] [--analyze-args "A B"]
+//                        [--screenshot FILE.png]
+//       runs `visaudit analyze --out DIR --quiet` (the built-in demo; --views and the space-separated
+//       --analyze-args passed on), then tests DIR/report.html
 //   node report.test.mjs --report DIR [--screenshot FILE.png]
 //       tests an existing report folder
 //
@@ -15,7 +16,10 @@
 //   - per view a visible stage-funnel SVG with one row per stage of report.json;
 //   - every <img> loaded (complete, naturalWidth > 0), and every PNG report.json lists is shown;
 //   - a hotspot row's link outlines the hotspot's bbox on the z-fight image, at the right place;
-//   - clicking an image opens it enlarged in a dialog.
+//   - clicking an image opens it enlarged in a dialog;
+//   - with routes (--views route:...): per route a plot with a line per metric, its worst frames
+//     linking to views that exist; with level maps: every map image loaded, a ring over each
+//     numbered worst position, centred on the position's dot and linking to its view.
 // Exit codes: 0 pass, 1 fail, 77 skipped (no chromium, or playwright-core not installed in
 // tests/browser/node_modules: `npm ci` there), as CTest's SKIP_RETURN_CODE.
 import { execFileSync } from 'node:child_process';
@@ -60,7 +64,8 @@ if (args.visaudit) {
     process.exit(2);
   }
   dir = args.out;
-  execFileSync(args.visaudit, ['analyze', '--out', dir, '--quiet', ...(args.views ? ['--views', args.views] : [])],
+  execFileSync(args.visaudit, ['analyze', '--out', dir, '--quiet', ...(args.views ? ['--views', args.views] : []),
+                               ...(args['analyze-args'] ? args['analyze-args'].split(' ').filter((x) => x) : [])],
                { stdio: 'inherit' });
 }
 if (!dir) {
@@ -125,11 +130,12 @@ async function checkScheme(colorScheme, screenshot) {
     if (!box || box.width < 300 || box.height < 60) fail(`${tag} view ${i}: funnel chart not visible (${JSON.stringify(box)})`);
     const rows = await funnel.locator('g.stage').count();
     if (rows !== view.stages.length) fail(`${tag} view ${i}: funnel has ${rows} rows for ${view.stages.length} stages`);
-    // A stage that ran draws a bar with a width proportional to its triangles_in.
+    // A stage that ran draws a bar with a width proportional to its triangles_in, at least 1 (a
+    // stage of 12 triangles after one of 8,000 is that thin).
     for (const st of view.stages.filter((s) => s.ran && s.triangles_in > 0)) {
       const bar = funnel.locator(`g.stage[data-stage="${st.name}"] rect.in`);
       const w = (await bar.count()) === 1 ? await bar.evaluate((r) => r.getBBox().width) : 0;
-      if (!(w > 1)) fail(`${tag} view ${i}: stage ${st.name} has no bar`);
+      if (!(w >= 1)) fail(`${tag} view ${i}: stage ${st.name} has no bar`);
     }
     // Every listed PNG is on the page.
     const srcs = await page.locator(`#v${i} img`).evaluateAll((imgs) => imgs.map((im) => im.getAttribute('src')));
@@ -174,6 +180,45 @@ async function checkScheme(colorScheme, screenshot) {
     }
   } else {
     console.log(`${tag} note: no view with hotspots; highlight not tested`);
+  }
+
+  // Routes: a plot per route, a line per metric, the worst frames linking to views on the page.
+  for (const route of report.routes || []) {
+    const id = 'route-' + route.name.toLowerCase().replace(/[^a-z0-9_-]/g, '_');
+    const plot = page.locator(`#${id}-plot`);
+    const pb = await plot.boundingBox();
+    if (!pb || pb.width < 300 || pb.height < 200) fail(`${tag} route ${route.name}: plot not visible (${JSON.stringify(pb)})`);
+    const lines = await plot.locator('polyline.line').evaluateAll((ls) => ls.map((l) => l.getAttribute('points').split(' ').length));
+    const analysed = Object.keys(route.series).filter((k) => !['view', 'frame', 'time'].includes(k) &&
+                                                             route.series[k].some((v) => v !== null));
+    if (lines.length !== analysed.length) fail(`${tag} route ${route.name}: ${lines.length} lines for ${analysed.length} metrics`);
+    for (const n of lines) if (n !== route.series.time.length) fail(`${tag} route ${route.name}: a line of ${n} points for ${route.series.time.length} frames`);
+    const worst = await plot.locator('a.worstframe').evaluateAll((as) => as.map((a) => a.getAttribute('href')));
+    const listed = Object.values(route.worst).reduce((n, w) => n + w.length, 0);
+    if (worst.length !== listed) fail(`${tag} route ${route.name}: ${worst.length} worst-frame links for ${listed} worst frames`);
+    for (const h of worst) if ((await page.locator(h).count()) !== 1) fail(`${tag} route ${route.name}: worst frame link ${h} leads nowhere`);
+  }
+  // Level maps: every map loaded; a ring over each numbered worst position, on its dot.
+  if (report.level_maps && report.level_maps.maps) {
+    for (const m of report.level_maps.maps) {
+      if (!m.image) continue;
+      const fig = page.locator(`#level-map-${m.metric.toLowerCase().replace(/[^a-z0-9_-]/g, '_')}`);
+      const img = fig.locator('img');
+      const ib = await img.boundingBox();
+      const natural = await img.evaluate((im) => ({ w: im.naturalWidth, h: im.naturalHeight }));
+      if (!ib || !(natural.w > 0)) { fail(`${tag} level map ${m.metric}: image not shown`); continue; }
+      const pins = fig.locator('a.lm-pin');
+      if ((await pins.count()) !== m.worst.length) fail(`${tag} level map ${m.metric}: ${await pins.count()} rings for ${m.worst.length} worst positions`);
+      for (let k = 0; k < Math.min(m.worst.length, await pins.count()); ++k) {
+        const w = m.worst[k], p = report.level_maps.positions[w.position];
+        const b = await pins.nth(k).boundingBox();
+        const cx = ib.x + (Math.floor(p.x) + 0.5) * ib.width / natural.w, cy = ib.y + (Math.floor(p.y) + 0.5) * ib.height / natural.h;
+        if (!b || Math.abs(b.x + b.width / 2 - cx) > 2 || Math.abs(b.y + b.height / 2 - cy) > 2)
+          fail(`${tag} level map ${m.metric}: ring ${k + 1} at ${JSON.stringify(b)} is not on position ${w.position} (${cx}, ${cy})`);
+        const href = await pins.nth(k).getAttribute('href');
+        if (href !== `#v${w.view}`) fail(`${tag} level map ${m.metric}: ring ${k + 1} links to ${href}, not #v${w.view}`);
+      }
+    }
   }
 
   // Click to enlarge.
