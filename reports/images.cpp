@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <optional>
 #include <cerrno>
 #include <cmath>
@@ -296,10 +297,61 @@ void depthRange(const std::vector<double> &depth, double *dMin, double *dMax) {
 
 uint8_t depthGray(double d, double dMin, double dMax) { return DepthGrayScale(dMin, dMax)(d); }
 
+// The grays of a whole buffer without a logarithm per pixel. Every finite positive depth lies in
+// [dMin, dMax] (the buffer's own range), cut into at most 2^14 buckets of equal steps of the
+// doubles' bit patterns (positive doubles order like their bits); a bucket whose depths all map
+// to one gray stores it, and only the depths of the other buckets (those holding a gray's
+// boundary: about 1% of them) take the logarithm. A bucket's depths share one gray when the gray
+// just outside its ends, a window rho further out, is the same at both: the gray of the computed
+// value is monotone (non-increasing) in d wherever log is, since the rest is a subtraction and a
+// division by constants, a multiplication, a subtraction, an addition and a truncation, each
+// monotone under rounding; glibc's log is within 0.52 ulp of log d (its implementation's stated
+// bound), taken as 4 ulps (8u |log d| <= 8u L, L the largest |log| involved), so for d' = d (1 + r)
+// the computed logs keep their order once log(1 + r) >= r / 2 exceeds 16u L: rho = 32u L.
 std::vector<uint8_t> depthGrays(const std::vector<double> &depth) {
-    const DepthGrayScale scale = depthGrayScale(depth);
+    double lo, hi;
+    depthRange(depth, &lo, &hi);
+    const DepthGrayScale scale(lo, hi);
     std::vector<uint8_t> g(depth.size());
-    for (size_t i = 0; i < depth.size(); ++i) g[i] = scale(depth[i]);
+    if (!scale.valid || !scale.spread) {  // no logarithm to spare
+        for (size_t i = 0; i < depth.size(); ++i) g[i] = scale(depth[i]);
+        return g;
+    }
+    auto bits = [](double d) {
+        uint64_t b;
+        std::memcpy(&b, &d, sizeof b);
+        return b;
+    };
+    auto fromBits = [](uint64_t b) {
+        double d;
+        std::memcpy(&d, &b, sizeof d);
+        return d;
+    };
+    constexpr int kBucketBits = 14;
+    constexpr uint16_t kUnresolved = 0xFFFF;
+    const uint64_t base = bits(lo), span = bits(hi) - base + 1;
+    const int shift = std::max(0, int(std::bit_width(span)) - kBucketBits);
+    const size_t buckets = size_t(((span - 1) >> shift) + 1);
+    const double L = std::max({1.0, std::fabs(std::log(lo)), std::fabs(std::log(hi))}) + 1;
+    const double rho = 32 * 0x1p-53 * L;
+    std::vector<uint16_t> table(buckets, kUnresolved);
+    for (size_t b = 0; b < buckets; ++b) {
+        const double first = fromBits(base + (uint64_t(b) << shift)), end = fromBits(base + (uint64_t(b + 1) << shift));
+        const double below = std::nextafter(first / (1 + 2 * rho), 0.0);
+        const double above = std::nextafter(end * (1 + 2 * rho), INFINITY);
+        if (!std::isfinite(above)) continue;
+        const uint8_t a = scale(below), z = scale(above);
+        if (a == z) table[b] = a;
+    }
+    for (size_t i = 0; i < depth.size(); ++i) {
+        const double d = depth[i];
+        if (!(d > 0) || !std::isfinite(d)) {
+            g[i] = 0;  // background (as scale(d))
+            continue;
+        }
+        const uint16_t t = table[size_t((bits(d) - base) >> shift)];
+        g[i] = t != kUnresolved ? uint8_t(t) : scale(d);
+    }
     return g;
 }
 

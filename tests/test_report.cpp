@@ -639,6 +639,43 @@ TEST(ReportImages, ColorMappings) {
     EXPECT_EQ(depthGray(5, 5, 5), 255);  // one depth only: white
 }
 
+// depthGrays (a bucket table, a logarithm only near a gray's boundary) gives every pixel the gray
+// DepthGrayScale computes for it: depth ranges from 1e-6 to 1e7, random depths, and depths one
+// ulp either side of every gray boundary (found by bisection on the doubles), plus background,
+// +inf, NaN, 0 and negative depths.
+TEST(ReportImages, DepthGraysMatchTheScaleAtEveryBoundary) {
+    uint64_t state = 3;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    };
+    const double ranges[][2] = {{1e-6, 1e-5}, {0.1, 1000}, {4, 8192}, {1, 1.0000001}, {3, 1e7}};
+    uint64_t checked = 0;
+    for (const auto &r : ranges) {
+        const DepthGrayScale scale(r[0], r[1]);
+        std::vector<double> depth = {r[0], r[1], 0.0, -1.0, INFINITY, NAN};
+        for (int i = 0; i < 20000; ++i) depth.push_back(r[0] * std::pow(r[1] / r[0], next()));
+        // Boundaries: bisect between depths whose grays differ, down to neighbouring doubles.
+        for (int i = 0; i < 300; ++i) {
+            double a = r[0] * std::pow(r[1] / r[0], next()), b = std::min(r[1], a * (1 + next() * 0.05));
+            if (scale(a) == scale(b)) continue;
+            while (std::nextafter(a, b) < b) {
+                const double m = a + (b - a) / 2;
+                if (m <= a || m >= b) break;
+                (scale(m) == scale(a) ? a : b) = m;
+            }
+            depth.insert(depth.end(), {std::nextafter(a, 0.0), a, b, std::nextafter(b, INFINITY)});
+        }
+        const std::vector<uint8_t> g = depthGrays(depth);
+        ASSERT_EQ(g.size(), depth.size());
+        for (size_t i = 0; i < depth.size(); ++i) {
+            ASSERT_EQ(int(g[i]), int(scale(depth[i]))) << "range " << r[0] << ".." << r[1] << ", depth " << depth[i];
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 100000u);
+}
+
 TEST(ReportImages, WriteAndReadBack) {
     TempDir dir;
     ASSERT_FALSE(dir.path.empty());

@@ -222,6 +222,78 @@ TEST(ZFightTwoNearest, ClippedPiecesOfOneTriangleAreOneSurface) {
 
 // ---- Hard cases --------------------------------------------------------------------------------
 
+// FightFilter's claim (no fight, both depths in range) against the exact encoders: every format
+// (opt-in ones too), near/far from 1e-3/1 to 10/1e7, depth pairs equal, an ulp apart, a relative
+// 1e-9..1e-1 apart and far apart, at wide magnitudes and both ends of the range. A pair the filter
+// decides must have key(d1) < key(d2) and no out-of-range depth; it must also decide most pairs
+// that are 1% or more apart (it is meant to spare their encoding).
+TEST(ZFightFilter, DecidesOnlyPairsThatCannotFightAndMostFarApartOnes) {
+    uint64_t state = 5;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    };
+    const double ranges[][2] = {{1e-3, 1}, {0.1, 1000}, {0.5, 5000}, {4, 8192}, {1, 1e5}, {10, 1e7}};
+    uint64_t decided = 0, farPairs = 0, farDecided = 0;
+    for (const auto &nf : ranges) {
+        const double n = nf[0], f = nf[1];
+        std::vector<DepthEncoder> enc;
+        for (const DepthFormat fmt : allDepthFormats()) enc.push_back(makeDepthEncoder(fmt, n, f));
+        const double dMin = n * 0.5, dMax = f * 1.5;  // pixels beyond the range too
+        const FightFilter filter(enc, dMin, dMax);
+        for (int i = 0; i < 40000; ++i) {
+            const double d1 = dMin * std::pow(dMax / dMin, next());
+            double d2 = d1;
+            switch (i % 5) {
+            case 0: break;
+            case 1: d2 = std::nextafter(d1, INFINITY); break;
+            case 2: d2 = d1 * (1 + std::pow(10.0, -9 + 8 * next())); break;
+            default: d2 = d1 * (1 + 0.01 + next() * 3); break;
+            }
+            if (!(d2 <= dMax)) continue;
+            const uint32_t c1 = filter.cell(d1), c2 = filter.cell(d2);
+            const bool far = d2 >= d1 * 1.01;
+            for (size_t k = 0; k < enc.size(); ++k) {
+                bool o1 = false, o2 = false;
+                const uint32_t k1 = depthKey(enc[k], d1, &o1), k2 = depthKey(enc[k], d2, &o2);
+                const bool inRange = d1 >= n && d2 <= f;
+                if (far && inRange && filter.filtered(k)) ++farPairs;
+                if (!filter.cannotFight(k, c1, c2)) continue;
+                ++decided;
+                farDecided += far && inRange;
+                ASSERT_LT(k1, k2) << depthFormatName(enc[k].format) << " n " << n << " f " << f << " d1 " << d1
+                                  << " d2 " << d2;
+                ASSERT_FALSE(o1 || o2) << depthFormatName(enc[k].format) << " d1 " << d1 << " d2 " << d2;
+            }
+            if (filter.cannotFightAny(c1, c2))
+                for (size_t k = 0; k < enc.size(); ++k) EXPECT_TRUE(!filter.filtered(k) || filter.cannotFight(k, c1, c2));
+        }
+    }
+    EXPECT_GT(decided, 1000000u);
+    EXPECT_GT(double(farDecided), 0.8 * double(farPairs)) << farDecided << " of " << farPairs;
+}
+
+// The windows the filter relies on, checked where they are tightest: for the quotient formats and
+// log24, depths a window apart keep their keys' order (one-ulp steps at the low end of the range,
+// where the quotient's rounding is largest relative to its growth).
+TEST(ZFightFilter, WindowsHoldAtTheirTightestDepths) {
+    for (const double n : {1e-3, 0.1, 4.0})
+        for (const double f : {100.0, 1e4, 1e6}) {
+            for (const DepthFormat fmt : {DepthFormat::unorm16, DepthFormat::unorm24, DepthFormat::f32, DepthFormat::log24}) {
+                const DepthEncoder e = makeDepthEncoder(fmt, n, f);
+                const double rho = monotoneWindow(e);
+                ASSERT_GE(rho, 0) << depthFormatName(fmt);
+                for (double d = n; d < f; d *= 1.37) {
+                    const double d2 = d * (1 + rho);
+                    if (d2 > f) break;
+                    EXPECT_LE(depthKey(e, d), depthKey(e, d2)) << depthFormatName(fmt) << " d " << d;
+                }
+            }
+            EXPECT_LT(monotoneWindow(makeDepthEncoder(DepthFormat::f32_gl, n, f)), 0);
+            EXPECT_EQ(monotoneWindow(makeDepthEncoder(DepthFormat::f32_reversed, n, f)), 0);
+        }
+}
+
 TEST(ZFightCases, CoplanarDuplicateFightsInEveryFormat) {
     // "tile" and "copy": the same two triangles, vertex for vertex. Their depth planes are
     // bit-identical, so both depths are equal at each of the tile's 8 x 8 = 64 pixels (columns and

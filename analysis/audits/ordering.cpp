@@ -202,11 +202,13 @@ std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
 
 namespace {
 
-// Per drawn item, the indices of its fragments in the view's fragment cache: a whole triangle's
-// are its screen triangles' ranges; a BSP piece's, those of its source whose surface point the
-// piece contains (the test the uncached sink makes per fragment, on the same values).
+// Per drawn item, its fragments in the view's fragment cache: a whole triangle's (and an unsplit
+// piece's) are its source's screen triangles' contiguous range, read in place; a split piece's are
+// those of its source whose surface point the piece contains (the test the uncached sink makes per
+// fragment, on the same values), listed in `index`.
 struct ItemFragments {
-    std::vector<uint64_t> begin;  // per item, + 1 entry
+    std::vector<uint8_t> listed;  // per item: 1 when its fragments are index[begin[k], begin[k + 1])
+    std::vector<uint64_t> begin;  // per item, + 1 entry (listed items only advance it)
     std::vector<uint32_t> index;
 };
 
@@ -275,9 +277,9 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
     for (size_t k = 0; k < items.size(); ++k)
         if (constrained(items[k])) tries[items[k].source].insert(*tree, items[k].piece, uint32_t(k));
 
-    // Per item its fragment count, then the lists in item order (counting sort: each source's
-    // fragments in ascending order into their owners' slots).
-    // Per cache fragment of a trie source (written before it is read; per-thread storage).
+    // Per split piece its fragment count, then the lists in item order (counting sort: each
+    // source's fragments in ascending order into their owners' slots). Per cache fragment of a
+    // trie source (written before it is read; per-thread storage).
     thread_local std::vector<uint32_t> owner;
     if (owner.size() < fc.pixel.size()) owner.resize(fc.pixel.size());
     std::vector<uint64_t> count(items.size(), 0);
@@ -291,12 +293,13 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
             if (k != UINT32_MAX) ++count[k];
         }
     }
+    sel.listed.assign(items.size(), 0);
     for (size_t k = 0; k < items.size(); ++k) {
         const DrawItem &it = items[k];
-        const auto [f0, f1] = fragmentsOf(it.source);
-        if (!constrained(it)) {
-            count[k] = f1 - f0;
-        } else if (tries.at(it.source).direct) {
+        if (!constrained(it)) continue;
+        sel.listed[k] = 1;
+        if (tries.at(it.source).direct) {
+            const auto [f0, f1] = fragmentsOf(it.source);
             std::vector<uint32_t> &list = directLists[k];
             for (uint64_t f = f0; f < f1; ++f)
                 if (bspPieceContains(*tree, *planes, it.piece, rays.point(fc.pixel[f], fc.depth[f])))
@@ -308,15 +311,8 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
     for (size_t k = 0; k < items.size(); ++k) sel.begin[k + 1] = sel.begin[k] + count[k];
     sel.index.resize(sel.begin.back());
     std::vector<uint64_t> next(sel.begin.begin(), sel.begin.end() - 1);
-    for (size_t k = 0; k < items.size(); ++k) {
-        const DrawItem &it = items[k];
-        const auto [f0, f1] = fragmentsOf(it.source);
-        if (!constrained(it)) {
-            for (uint64_t f = f0; f < f1; ++f) sel.index[next[k]++] = uint32_t(f);
-        } else if (auto d = directLists.find(k); d != directLists.end()) {
-            for (uint32_t f : d->second) sel.index[next[k]++] = f;
-        }
-    }
+    for (const auto &[k, list] : directLists)
+        for (uint32_t f : list) sel.index[next[k]++] = f;
     for (auto &[s, trie] : tries) {
         if (trie.direct) continue;
         const auto [f0, f1] = fragmentsOf(s);
@@ -386,7 +382,7 @@ DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, 
     for (size_t j = 0; j < items.size(); ++j) {
         const size_t k = reverse ? items.size() - 1 - j : j;
         const uint32_t current = items[k].source + 1;
-        if (sel) {
+        if (sel && sel->listed[k]) {
             for (uint64_t j = sel->begin[k]; j < sel->begin[k + 1]; ++j) {
                 const uint32_t f = sel->index[j];
                 target.write(fc.pixel[f], fc.depth[f], current);

@@ -15,7 +15,9 @@
 #include "analysis/audits/zfight.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <limits>
 #include <unordered_map>
@@ -348,25 +350,199 @@ void explainHotspot(double nearZ, double farZ, const std::optional<DepthFormatSp
 // ---- The analysis -----------------------------------------------------------------------------
 
 namespace {
+
+// ---- 2a. Pixels that cannot fight, decided without encoding --------------------------------------
+//
+// A two-surface pixel fights in a format when key(d1) >= key(d2) (d1 <= d2). Most such pixels hold
+// surfaces far apart in depth (a wall and the room behind it), whose keys differ in every format:
+// they need no encoding if that can be proven cheaply. The proof uses monotonicity: where a
+// format's computed key never decreases as d grows, any depth in an interval has a key between the
+// keys of the interval's ends. The view's depth range is cut into cells (equal steps of the
+// doubles' bit patterns: 256 per octave, so a cell spans 0.4% of its depth); per format and cell,
+// kmax bounds the keys of the cell's depths from above and kmin from below, and a pixel whose
+// nearer depth's cell has kmax below the farther depth's cell's kmin cannot fight -- keys
+// kmax(c1) >= key(d1) and key(d2) >= kmin(c2) > kmax(c1). Per cell c1 the first cell c2 from which
+// that holds is precomputed, for every format at once, so the common pixel costs two cell indices
+// and one comparison instead of 24 encodings. The others are encoded exactly, as before.
+//
+// Monotonicity, per format, for depths inside [minValidDepth, far] (no clamping; cells outside
+// that range are unknown, and their pixels are encoded):
+//   * exactly monotone: every operation is monotone in d and IEEE rounding preserves order:
+//     float(d), float(1/d), (int)(C/d), (int)(C/(d+1)), float(n/d); unorm24_gl and the reversed
+//     quotients n(f-d)/(d(f-n)) (a non-increasing numerator over a non-decreasing denominator);
+//   * monotone beyond a relative window rho: the quotient f(d-n)/(d(f-n)) of unorm16/24 and f32
+//     has a numerator and a denominator that both grow with d, so the rounded quotient may step
+//     back by an ulp. It is g(d)(1 + t), |t| <= gamma(4) (d - n, f * that, d * fl(f - n), the
+//     division), with g(d) = (f / fl(f-n))(1 - n/d) increasing; for d' = d(1 + r),
+//     g(d')/g(d) - 1 = (n/d) r / ((1 + r)(1 - n/d)) >= (n/f) r / 2 (r <= 1), so the computed values
+//     keep their order once (n/f) r / 2 >= E = 2 gamma(4) / (1 - gamma(4)), i.e. r >= rho = 2 E f / n;
+//   * log24: log(C d + 1) / log(C f + 1) computed as fl(log(fl(fl(C d) + 1)) / D): the argument is
+//     (1 + C d)(1 + eta), |eta| <= gamma(2), moving the logarithm by at most delta = 1.01 gamma(2);
+//     glibc's log is within 0.52 ulp (its implementation's stated bound), taken here as 4 ulps
+//     (8u relative), and the division adds u: eps = gamma(9) relative. With h(d) = log(1 + C d),
+//     h(d') - h(d) >= log(1 + s r) >= s r / 2 for s r <= 1, s = C n / (1 + C n); order is kept once
+//     s r / 2 >= 2 delta + 2 eps (h(f) + delta), i.e. r >= rho = (4 delta + 4 eps (h(f) + delta)) / s;
+//   * f32_gl and f32_gl_reversed (opt-in): not filtered (their window value can cross zero).
+// With rho > 0, kmax of a cell is the key at its upper end times (1 + 2 rho), rounded up, and kmin
+// the key at its lower end divided by (1 + 2 rho), rounded down: every depth d of the cell lies a
+// full window below the first and above the second.
+constexpr uint32_t kCellBits = 12;  // at most 4096 cells over the view's depth range
+
+}  // namespace
+
+double monotoneWindow(const DepthEncoder &e) {
+    const double n = e.nearZ, f = e.farZ;
+    switch (e.format) {
+    case DepthFormat::linear_f32:
+    case DepthFormat::inv_f32:
+    case DepthFormat::int31_inv:
+    case DepthFormat::uint32_inv:
+    case DepthFormat::uint32_inv1:
+    case DepthFormat::unorm24_gl:
+    case DepthFormat::f32_reversed:
+    case DepthFormat::f32_reversed_inf:
+    case DepthFormat::unorm16_reversed:
+    case DepthFormat::unorm24_reversed: return 0;
+    case DepthFormat::unorm16:
+    case DepthFormat::unorm24:
+    case DepthFormat::depth24plus:
+    case DepthFormat::f32:
+    case DepthFormat::depth32float: {
+        const double E = 2 * gamma(4) / (1 - gamma(4));
+        const double rho = 2 * E * f / n;
+        return rho <= 0.25 ? rho : -1;
+    }
+    case DepthFormat::log24: {
+        const double delta = 1.01 * gamma(2), eps = gamma(9);
+        const double s = e.logC * n / (1 + e.logC * n);
+        const double rho = (4 * delta + 4 * eps * (std::log(e.logC * f + 1) + delta)) / s;
+        return std::isfinite(rho) && rho > 0 && rho <= 0.25 ? rho : -1;
+    }
+    case DepthFormat::f32_gl:
+    case DepthFormat::f32_gl_reversed: return -1;
+    }
+    return -1;
+}
+
+namespace {
+
+uint64_t doubleBits(double d) {
+    uint64_t b;
+    std::memcpy(&b, &d, sizeof b);
+    return b;
+}
+double bitsDouble(uint64_t b) {
+    double d;
+    std::memcpy(&d, &b, sizeof d);
+    return d;
+}
+
+template <DepthFormat F>
+FightFilter::Cells safeCells(const DepthEncoder &enc, uint64_t base, int shift, uint32_t C, double rho) {
+    const uint32_t kNever = C + 1;
+    FightFilter::Cells out;
+    out.firstSafe.assign(C + 1, kNever);
+    const double lo = enc.minValidDepth, hi = enc.farZ;
+    auto key = [&](double d) {
+        uint32_t k = 0;
+        bool oor = false;
+        encodeDepth<F>(enc, d, k, oor);
+        return k;
+    };
+    auto lower = [&](uint32_t c) { return bitsDouble(base + (uint64_t(c) << shift)); };
+    // Known cells: the whole cell and its windows inside [lo, hi]. The conditions grow with c, so
+    // the known cells are one run [first, last].
+    std::vector<uint32_t> kmax(C, UINT32_MAX), kmin(C, 0);
+    uint32_t first = C, last = 0;
+    for (uint32_t c = 0; c < C; ++c) {
+        const double g0 = lower(c), g1 = lower(c + 1);
+        double up = g1, down = g0;
+        if (rho > 0) {
+            up = std::nextafter(g1 * (1 + 2 * rho), INFINITY);
+            down = std::nextafter(g0 / (1 + 2 * rho), 0.0);
+        }
+        if (!(down >= lo && up <= hi)) continue;
+        kmax[c] = key(up);
+        kmin[c] = key(down);
+        first = std::min(first, c);
+        last = c;
+    }
+    if (first == C) return out;
+    out.last = last;
+    // Suffix minima of kmin over [c, last] (sorted), then per c1 the smallest c2 in (c1, last]
+    // with sufMin[c2] > kmax[c1], by binary search.
+    std::vector<uint32_t> sufMin(C, 0);
+    sufMin[last] = kmin[last];
+    for (uint32_t c = last; c-- > first;) sufMin[c] = std::min(kmin[c], sufMin[c + 1]);
+    for (uint32_t c1 = first; c1 <= last; ++c1) {
+        uint32_t a = c1 + 1, b = last + 1;
+        while (a < b) {
+            const uint32_t m = a + (b - a) / 2;
+            if (sufMin[m] > kmax[c1]) b = m;
+            else a = m + 1;
+        }
+        out.firstSafe[c1] = a <= last ? a : kNever;
+    }
+    return out;
+}
+
+}  // namespace
+
+FightFilter::FightFilter(const std::vector<DepthEncoder> &encoders, double dMin, double dMax) {
+    windows.assign(encoders.size(), -1);
+    perFormat.resize(encoders.size());
+    if (!(dMin > 0 && dMin <= dMax && std::isfinite(dMax))) return;
+    base = doubleBits(dMin);
+    const uint64_t span = doubleBits(dMax) - base + 1;
+    shift = std::max(0, int(std::bit_width(span)) - int(kCellBits));
+    count = uint32_t(((span - 1) >> shift) + 1);
+    firstSafeAll.assign(count + 1, 0);
+    lastAll = count;
+    for (size_t i = 0; i < encoders.size(); ++i) {
+        windows[i] = monotoneWindow(encoders[i]);
+        if (windows[i] < 0) continue;
+        perFormat[i] = dispatchDepthFormat(encoders[i].format, [&]<DepthFormat Fmt>() {
+            return safeCells<Fmt>(encoders[i], base, shift, count, windows[i]);
+        });
+        for (uint32_t c = 0; c <= count; ++c) firstSafeAll[c] = std::max(firstSafeAll[c], perFormat[i].firstSafe[c]);
+        lastAll = std::min(lastAll, perFormat[i].last);
+        anyFiltered = true;
+    }
+}
+
+uint32_t FightFilter::cell(double d) const {
+    if (!(d > 0) || !std::isfinite(d) || count == 0) return count;
+    const uint64_t b = doubleBits(d);
+    return b < base || ((b - base) >> shift) >= count ? count : uint32_t((b - base) >> shift);
+}
+
+namespace {
+
 // 2. Per format: the fight bit (key(d1) >= key(d2), d1 <= d2: equal stored values or swapped order)
 //    and out-of-range pixels (either surface clamped by the encoder). The two-surface pixels are
-//    gathered once into a compact list that every format walks; a one-surface pixel needs no
-//    encoding when its depth is in [minValidDepth, far] (every format clamps d into [minValidDepth,
-//    hi] with hi = far or +inf, render/depth_format_impl.h), which the one-surface depths' range
-//    decides for all of them at once, per format; otherwise they are encoded one by one.
+//    gathered once into a compact list; those that cannot fight in any filtered format (2a) are set
+//    aside, and every format encodes the rest (every pixel, for a format not filtered). A
+//    one-surface pixel needs no encoding when its depth is in [minValidDepth, far] (every format
+//    clamps d into [minValidDepth, hi] with hi = far or +inf, render/depth_format_impl.h), which the
+//    one-surface depths' range decides for all of them at once, per format; otherwise they are
+//    encoded one by one.
 void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &settings, ZFightResult &r) {
     const size_t N = two.pixels(), F = settings.formats.size();
     std::vector<uint32_t> pixel;
     std::vector<double> near1, near2;
     double oneMin = kInf, oneMax = -kInf;
     bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
+    double twoMin = kInf, twoMax = 0;  // finite positive depths of the two-surface pixels
     for (size_t p = 0; p < N; ++p) {
         if (two.screen1[p] == kNoFragment) continue;
         const double d1 = two.depth1[p];
         if (two.screen2[p] != kNoFragment) {
+            const double d2 = two.depth2[p];
             pixel.push_back(uint32_t(p));
             near1.push_back(d1);
-            near2.push_back(two.depth2[p]);
+            near2.push_back(d2);
+            for (const double d : {d1, d2})
+                if (d > 0 && std::isfinite(d)) twoMin = std::min(twoMin, d), twoMax = std::max(twoMax, d);
         } else {
             oneMin = std::min(oneMin, d1);
             oneMax = std::max(oneMax, d1);
@@ -375,20 +551,39 @@ void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &
     }
     const size_t n2 = pixel.size();
     std::vector<uint32_t> mask(n2, 0);
+
+    // 2a. The pixels that cannot fight in any filtered format are set aside.
+    std::vector<DepthEncoder> enc(F);
+    for (size_t i = 0; i < F; ++i) enc[i] = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
+    const FightFilter filter(enc, n2 ? twoMin : 0, twoMax);
+    std::vector<uint32_t> cell1(n2), cell2(n2), unsafe;  // unsafe: indices into the two-surface list
+    for (size_t k = 0; k < n2; ++k) {
+        cell1[k] = filter.cell(near1[k]);
+        cell2[k] = filter.cell(near2[k]);
+        if (!filter.cannotFightAny(cell1[k], cell2[k])) unsafe.push_back(uint32_t(k));
+    }
+
     for (size_t i = 0; i < F; ++i) {
-        const DepthEncoder enc = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
+        const DepthEncoder &e = enc[i];
         const uint32_t bit = uint32_t(1) << i;
-        const double lo = enc.minValidDepth, hi = enc.farZ;
+        const double lo = e.minValidDepth, hi = e.farZ;
         const bool oneInRange = !oneUnordered && oneMin >= lo && oneMax <= hi;
         uint64_t oor = 0;
-        dispatchDepthFormat(enc.format, [&]<DepthFormat Fmt>() {
-            for (size_t k = 0; k < n2; ++k) {
+        dispatchDepthFormat(e.format, [&]<DepthFormat Fmt>() {
+            auto encodePixel = [&](size_t k) {
                 uint32_t k1 = 0, k2 = 0;
                 bool o1 = false, o2 = false;
-                encodeDepth<Fmt>(enc, near1[k], k1, o1);
-                encodeDepth<Fmt>(enc, near2[k], k2, o2);
+                encodeDepth<Fmt>(e, near1[k], k1, o1);
+                encodeDepth<Fmt>(e, near2[k], k2, o2);
                 mask[k] |= k1 >= k2 ? bit : 0;
                 oor += (o1 || o2) ? 1 : 0;
+            };
+            if (!filter.filtered(i)) {
+                for (size_t k = 0; k < n2; ++k) encodePixel(k);
+            } else {
+                // The others cannot fight here and lie in the format's range (FightFilter).
+                for (const uint32_t k : unsafe)
+                    if (!filter.cannotFight(i, cell1[k], cell2[k])) encodePixel(k);
             }
             if (oneInRange) return;
             for (size_t p = 0; p < N; ++p) {
@@ -397,7 +592,7 @@ void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &
                 if (d1 >= lo && d1 <= hi) continue;
                 uint32_t k1 = 0;
                 bool o1 = false;
-                encodeDepth<Fmt>(enc, d1, k1, o1);
+                encodeDepth<Fmt>(e, d1, k1, o1);
                 oor += o1 ? 1 : 0;
             }
         });

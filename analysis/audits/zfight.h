@@ -54,6 +54,46 @@ struct TwoNearest {
 TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic,
                           const uint8_t *singleSided = nullptr);
 
+// ---- Pixels that cannot fight, decided without encoding (zfight.cpp, 2a) ----------------------
+
+// The relative window beyond which a format's computed key keeps the order of the depths inside
+// [minValidDepth, far]: for d < d' with d' >= d (1 + window), key(d) <= key(d'). 0: exactly
+// monotone; negative: no such window is claimed (the format is not filtered). Derived per format
+// in zfight.cpp.
+double monotoneWindow(const DepthEncoder &e);
+
+// Cells over a view's depth range [dMin, dMax] (equal steps of the doubles' bit patterns, at most
+// 4096, about 256 per octave) with, per format, the first cell from which a farther depth's key
+// is certainly above a nearer depth's: a pair of depths d1 <= d2 in cells c1, c2 with
+// cannotFight(format, c1, c2) has key(d1) < key(d2) and both depths in the format's range, so it
+// neither fights nor is out of range there -- without encoding either depth.
+struct FightFilter {
+    FightFilter(const std::vector<DepthEncoder> &encoders, double dMin, double dMax);
+    uint32_t cell(double d) const;  // `count` for depths outside the cells (never decided)
+    bool filtered(size_t format) const { return windows[format] >= 0 && count > 0; }
+    bool cannotFight(size_t format, uint32_t c1, uint32_t c2) const {
+        const Cells &c = perFormat[format];
+        return filtered(format) && c.firstSafe[c1] <= c2 && c2 <= c.last;
+    }
+    // In every filtered format at once (false when no format is filtered).
+    bool cannotFightAny(uint32_t c1, uint32_t c2) const {
+        return anyFiltered && firstSafeAll[c1] <= c2 && c2 <= lastAll;
+    }
+
+    struct Cells {
+        std::vector<uint32_t> firstSafe;  // per cell + "outside": the first safe c2, count + 1 for none
+        uint32_t last = 0;                // the last cell inside the format's range
+    };
+    uint64_t base = 0;
+    int shift = 0;
+    uint32_t count = 0;
+    std::vector<double> windows;
+    std::vector<Cells> perFormat;
+    std::vector<uint32_t> firstSafeAll;
+    uint32_t lastAll = 0;
+    bool anyFiltered = false;
+};
+
 // ---- Classes of a pixel with two surfaces -----------------------------------------------------
 
 enum class ZPixelClass : uint8_t {
