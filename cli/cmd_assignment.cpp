@@ -75,10 +75,12 @@ int cmdAssignment(const AssignmentOptions &o) {
         fail("--images " + o.images + ": expected ids, depth or ids,depth (what the z-buffer stage hands in)");
         return kExitBadInput;
     }
-    const std::string answers = o.answers.empty() ? o.out + "-answers" : o.answers;
+    std::string outName = o.out;  // "kit/" names the folder "kit": its answers are "kit-answers"
+    while (outName.size() > 1 && outName.back() == '/') outName.pop_back();
+    const std::string answers = o.answers.empty() ? outName + "-answers" : o.answers;
     if (within(answers, o.out) || within(o.out, answers)) {
         fail("--answers " + answers + " and --out " + o.out + " overlap; the answers go to a folder of their own that "
-             "the students never get (e.g. --answers " + o.out + "-answers)");
+             "the students never get (e.g. --answers " + outName + "-answers)");
         return kExitBadInput;
     }
     PipelineSettings s;

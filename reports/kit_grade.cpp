@@ -25,7 +25,11 @@ using OJson = nlohmann::ordered_json;
 
 namespace {
 
+// A submission's JSON: read once, by the bounded parser (json::parseFile), in its own key order.
+using SJson = json::Json;
+
 std::string dumps(const OJson &j) { return j.dump(-1, ' ', false, OJson::error_handler_t::replace); }
+std::string dumps(const SJson &j) { return j.dump(-1, ' ', false, SJson::error_handler_t::replace); }
 
 std::string fmtDouble(double v) {
     char buf[40];
@@ -205,6 +209,22 @@ Tolerance kitTolerance(const ToleranceRules &t, const std::string &metric, bool 
 }
 
 namespace {
+
+// Whether `path`, its links followed, lies inside `dir` (followed too): a submission's files are read
+// only there, so a link cannot make the grader read, and quote in a message, someone else's file.
+bool withinFolder(const fs::path &path, const fs::path &dir) {
+    std::error_code ec;
+    const fs::path d = fs::weakly_canonical(dir, ec);
+    if (ec) return false;
+    const fs::path p = fs::weakly_canonical(path, ec);
+    if (ec) return false;
+    auto pi = p.begin();
+    for (auto di = d.begin(); di != d.end(); ++di, ++pi) {
+        if (di->empty()) continue;  // a trailing separator
+        if (pi == p.end() || *pi != *di) return false;
+    }
+    return true;
+}
 
 // ---- Student images ---------------------------------------------------------------------------------
 
@@ -396,6 +416,7 @@ bool readStudentImage(const std::string &path, const std::string &shown, bool de
 bool checkValues(const Pixels &px, const std::string &shown, bool depth, std::string *why) {
     for (size_t i = 0; i < px.v.size(); ++i) {
         const double d = px.v[i];
+        if (!std::isnan(d) && (depth || (d >= 0 && d <= 4294967295.0 && d == std::floor(d)))) continue;
         const int x = int(i % size_t(px.width)), y = int(i / size_t(px.width));
         const std::string at = " at pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
         if (std::isnan(d)) {
@@ -594,7 +615,7 @@ struct Grader {
     std::string metric(Stage st, const std::string &key) const { return std::string(stageName(st)) + "." + key; }
 
     // A number of the answer against the submission's value at the same key.
-    void number(const KitView &v, Stage st, const std::string &key, const OJson &ref, const OJson *sub) {
+    void number(const KitView &v, Stage st, const std::string &key, const OJson &ref, const SJson *sub) {
         const std::string r = dumps(ref);
         if (!sub || sub->is_null()) return item(v, st, key, r, "missing", false, missingWhy);
         if (!sub->is_number()) return item(v, st, key, r, "not a number: " + dumps(*sub), false);
@@ -604,14 +625,14 @@ struct Grader {
         item(v, st, key, r, dumps(*sub), diff <= t.abs || diff <= t.rel * std::fabs(a));
     }
 
-    void histogram(const KitView &v, Stage st, const OJson &ref, const OJson *sub) {
+    void histogram(const KitView &v, Stage st, const OJson &ref, const SJson *sub) {
         const std::string key = "histogram";
         std::vector<double> a, b;
         for (const OJson &x : ref) a.push_back(x.get<double>());
         const std::string r = dumps(ref);
         if (!sub || sub->is_null()) return item(v, st, key, r, "missing", false, missingWhy);
         if (!sub->is_array()) return item(v, st, key, r, "not an array: " + dumps(*sub), false);
-        for (const OJson &x : *sub) {
+        for (const SJson &x : *sub) {
             if (!x.is_number()) return item(v, st, key, r, dumps(*sub), false, "not every entry is a number");
             b.push_back(x.get<double>());
         }
@@ -633,13 +654,13 @@ struct Grader {
     }
 
     // A list of ids (backface's kept): compared as sets.
-    bool idSet(const OJson *sub, std::vector<uint32_t> *out, std::string *why) const {
+    bool idSet(const SJson *sub, std::vector<uint32_t> *out, std::string *why) const {
         if (!sub->is_array()) {
             *why = "not an array of ids: " + dumps(*sub).substr(0, 60);
             return false;
         }
         std::set<uint32_t> seen;
-        for (const OJson &x : *sub) {
+        for (const SJson &x : *sub) {
             if (!x.is_number_unsigned() || x.get<uint64_t>() > UINT32_MAX) {
                 *why = "not an id: " + dumps(x);
                 return false;
@@ -653,7 +674,7 @@ struct Grader {
         return true;
     }
 
-    void kept(const KitView &v, const StageAnswer &a, const OJson *sub) {
+    void kept(const KitView &v, const StageAnswer &a, const SJson *sub) {
         std::vector<uint32_t> ref;
         for (const OJson &x : a.answer["kept"]) ref.push_back(x.get<uint32_t>());
         const std::string r = std::to_string(ref.size()) + " ids";
@@ -691,7 +712,7 @@ struct Grader {
                      "with n = (v1 − v0) × (v2 − v0), a triangle faces the eye when n·(eye − v0) > 0.");
     }
 
-    void polygons(const KitView &v, const StageAnswer &a, const OJson *sub) {
+    void polygons(const KitView &v, const StageAnswer &a, const SJson *sub) {
         const Stage st = Stage::clip;
         const OJson &ref = a.answer["polygons"];
         const std::string r = std::to_string(ref.size()) + " polygons";
@@ -701,13 +722,13 @@ struct Grader {
         std::map<uint32_t, std::vector<std::array<double, 4>>> mine;
         double nearest = INFINITY;  // the least d of any submitted vertex
         for (size_t i = 0; i < sub->size(); ++i) {
-            const OJson &p = (*sub)[i];
+            const SJson &p = (*sub)[i];
             const std::string at = "polygons[" + std::to_string(i) + "]";
             if (!p.is_object() || !p.contains("id") || !p["id"].is_number_unsigned() || !p.contains("vertices") ||
                 !p["vertices"].is_array())
                 return item(v, st, "polygons", r, "unreadable", false, at + ": expected {\"id\": ID, \"vertices\": [[x, y, w, d], ...]}");
             std::vector<std::array<double, 4>> vs;
-            for (const OJson &q : p["vertices"]) {
+            for (const SJson &q : p["vertices"]) {
                 if (!q.is_array() || q.size() != 4)
                     return item(v, st, "polygons", r, "unreadable", false, at + ": a vertex is [x, y, w, d]");
                 std::array<double, 4> c{};
@@ -784,14 +805,14 @@ struct Grader {
              "the eye (w ≤ 0), cannot be projected.");
     }
 
-    void order(const KitView &v, const StageAnswer &a, const OJson *sub) {
+    void order(const KitView &v, const StageAnswer &a, const SJson *sub) {
         const Stage st = Stage::painter;
         const OJson &ref = a.answer["order"];
         const std::string r = std::to_string(ref.size()) + " ids";
         if (!sub || sub->is_null()) return item(v, st, "order", r, "missing", false, missingWhy);
         if (!sub->is_array()) return item(v, st, "order", r, "unreadable", false, "not an array of ids");
         std::vector<uint32_t> s;
-        for (const OJson &x : *sub) {
+        for (const SJson &x : *sub) {
             if (!x.is_number_unsigned() || x.get<uint64_t>() > UINT32_MAX)
                 return item(v, st, "order", r, "unreadable", false, "not an id: " + dumps(x));
             s.push_back(x.get<uint32_t>());
@@ -831,11 +852,11 @@ struct Grader {
     }
 
     // A per-pixel image of the submission against the reference's ids.
-    void image(const KitView &v, Stage st, const std::string &which, const StageAnswer &a, const OJson *block,
+    void image(const KitView &v, Stage st, const std::string &which, const StageAnswer &a, const SJson *block,
                const ScreenTriangles &screen, const PixelGrade *idsGrade) {
         const std::string key = which;
         const std::string r = "all " + std::to_string(a.ids.size()) + " pixels";
-        const OJson *name = block && block->contains(which) ? &(*block)[which] : nullptr;
+        const SJson *name = block && block->contains(which) ? &(*block)[which] : nullptr;
         if (!name || name->is_null()) return item(v, st, key, r, "missing", false, missingWhy);
         if (!name->is_string() || name->get<std::string>().empty())
             return item(v, st, key, r, "unreadable", false, "expected the image's file name, got " + dumps(*name));
@@ -843,10 +864,10 @@ struct Grader {
         // A file of the submission folder (or below it): the grader reads nothing else.
         bool inside = !fs::path(file).is_absolute();
         for (const fs::path &part : fs::path(file)) inside = inside && part != "..";
-        if (!inside)
+        const fs::path path = fs::path(subDir) / file;
+        if (!inside || !withinFolder(path, subDir))
             return item(v, st, key, r, "unreadable", false,
                         "'" + file + "' is not a file of the submission folder; name the image relative to it");
-        const fs::path path = fs::path(subDir) / file;
         Pixels px;
         std::string why;
         const bool depth = which == "depth";
@@ -897,7 +918,7 @@ struct Grader {
                  ".");
     }
 
-    void stage(const KitView &v, const StageAnswer &a, const OJson *block) {
+    void stage(const KitView &v, const StageAnswer &a, const SJson *block) {
         const Stage st = a.stage;
         const std::string saved = missingWhy;
         if (!missingWhy.empty()) {
@@ -908,7 +929,7 @@ struct Grader {
             missingWhy = "views." + v.name + "." + stageName(st) + " is " + dumps(*block).substr(0, 40) + ", not an object";
             block = nullptr;
         }
-        auto sub = [&](const std::string &k) -> const OJson * {
+        auto sub = [&](const std::string &k) -> const SJson * {
             return block && block->contains(k) ? &(*block)[k] : nullptr;
         };
         for (auto it = a.answer.begin(); it != a.answer.end(); ++it) {
@@ -919,9 +940,9 @@ struct Grader {
             else if (k == "order") order(v, a, sub(k));
             else if (k == "histogram") histogram(v, st, ref, sub(k));
             else if (ref.is_object()) {
-                const OJson *o = sub(k);
+                const SJson *o = sub(k);
                 for (auto jt = ref.begin(); jt != ref.end(); ++jt) {
-                    const OJson *x = o && o->is_object() && o->contains(jt.key()) ? &(*o)[jt.key()] : nullptr;
+                    const SJson *x = o && o->is_object() && o->contains(jt.key()) ? &(*o)[jt.key()] : nullptr;
                     number(v, st, k + "." + jt.key(), jt.value(), x);
                 }
             } else {
@@ -929,8 +950,8 @@ struct Grader {
             }
         }
         if (st == Stage::clip) {
-            const OJson *pp = sub("per_plane");
-            const OJson *near = pp && pp->is_object() && pp->contains("near") ? &(*pp)["near"] : nullptr;
+            const SJson *pp = sub("per_plane");
+            const SJson *near = pp && pp->is_object() && pp->contains("near") ? &(*pp)["near"] : nullptr;
             if (near && near->is_number() && near->get<double>() == 0 && a.answer["per_plane"]["near"].get<uint64_t>() > 0)
                 nearPlaneHint(v, "per_plane.near is 0 where " + dumps(a.answer["per_plane"]["near"]) +
                                      " triangles cross the near plane");
@@ -965,6 +986,8 @@ KitGrade gradeSubmission(const Kit &kit, const AnswerSet &answers, const Toleran
     std::string err;
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) g.error = dir + ": not a folder (a submission is a folder holding submission.json)";
+    else if (fs::exists(file, ec) && !withinFolder(file, dir))
+        g.error = file + ": a link to a file outside the submission folder; hand in the file itself";
     else if (!json::parseFile(file, &doc, &err, maxJsonDepth)) g.error = err;
     else if (!doc.root.is_object() || !doc.root.contains("format") || doc.root["format"] != kSubmissionFormat)
         g.error = json::where(doc, json::Path{} / "format") + ": \"format\" must be \"" + kSubmissionFormat +
@@ -972,13 +995,12 @@ KitGrade gradeSubmission(const Kit &kit, const AnswerSet &answers, const Toleran
     else if (!doc.root.contains("views") || !doc.root["views"].is_object())
         g.error = json::where(doc, json::Path{} / "views") + ": expected \"views\": {\"VIEW\": {...}} as in the kit's "
                   "template/submission.json";
-    OJson root;
-    if (g.error.empty()) root = OJson::parse(doc.text);
+    const SJson &root = doc.root;
     gr.missingWhy = g.error;
 
     for (size_t vi = 0; vi < kit.views.size(); ++vi) {
         const KitView &v = kit.views[vi];
-        const OJson *vb = nullptr;
+        const SJson *vb = nullptr;
         std::string saved = gr.missingWhy;
         if (g.error.empty()) {
             if (root["views"].contains(v.name)) vb = &root["views"][v.name];
@@ -990,7 +1012,7 @@ KitGrade gradeSubmission(const Kit &kit, const AnswerSet &answers, const Toleran
         }
         for (size_t si = 0; si < kit.stages.size(); ++si) {
             const StageAnswer &a = answers.views[vi][si];
-            const OJson *block = vb && vb->contains(stageName(a.stage)) ? &(*vb)[stageName(a.stage)] : nullptr;
+            const SJson *block = vb && vb->contains(stageName(a.stage)) ? &(*vb)[stageName(a.stage)] : nullptr;
             gr.stage(v, a, vb ? block : nullptr);
         }
         gr.missingWhy = saved;
@@ -1148,7 +1170,9 @@ std::string gradesCsv(const std::vector<KitGrade> &grades, const Kit &kit) {
         std::string failures, hints;
         for (const GradeItem &it : g.items)
             if (!it.pass) failures += (failures.empty() ? "" : "; ") + it.view + " " + it.stage + "." + it.key;
-        for (const GradeHint &h : g.hints) hints += (hints.empty() ? "" : "; ") + h.view + " " + h.id;
+        std::set<std::string> said;  // a mistake in two stages of a view (the rasterizer's fill rule) once
+        for (const GradeHint &h : g.hints)
+            if (said.insert(h.view + " " + h.id).second) hints += (hints.empty() ? "" : "; ") + h.view + " " + h.id;
         o += "," + std::to_string(g.passed) + "," + std::to_string(g.failed) + "," + csvField(failures) + "," +
              csvField(hints) + "," + csvField(g.error) + "\n";
     }

@@ -683,6 +683,63 @@ class BadSubmission : public Assignment {
     }
 };
 
+// The correct pictures written as CSV and as float EXR (ids and depth) grade the same: 100%.
+TEST_F(BadSubmission, EveryImageFormatGradesTheSame) {
+    const fs::path d = copy("formats");
+    auto readIds = [](const fs::path &png, std::vector<float> *v, int *W, int *H) {
+        auto in = OIIO::ImageInput::open(png.string());
+        ASSERT_TRUE(in);
+        *W = in->spec().width, *H = in->spec().height;
+        std::vector<uint16_t> u(size_t(*W) * size_t(*H));
+        ASSERT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT16, u.data()));
+        v->assign(u.begin(), u.end());
+    };
+    auto csv = [](const fs::path &p, int W, const std::vector<float> &v) {
+        std::ofstream f(p);
+        for (size_t i = 0; i < v.size(); ++i) f << (std::isinf(v[i]) ? std::string("inf") : json(double(v[i])).dump())
+                                                 << ((i + 1) % size_t(W) ? "," : "\n");
+    };
+    auto readPfm = [](const fs::path &p, int W, int H) {
+        std::ifstream f(p, std::ios::binary);
+        std::string magic;
+        int w, h;
+        double scale;
+        f >> magic >> w >> h >> scale;
+        f.get();
+        std::vector<float> rows(size_t(W) * size_t(H)), v(rows.size());
+        f.read(reinterpret_cast<char *>(rows.data()), std::streamsize(4 * rows.size()));
+        for (int y = 0; y < H; ++y)
+            std::copy_n(&rows[size_t(H - 1 - y) * size_t(W)], W, &v[size_t(y) * size_t(W)]);
+        return v;
+    };
+    std::vector<float> spawnIds, topIds;
+    int W, H, TW, TH;
+    readIds(d / "spawn.ids.png", &spawnIds, &W, &H);
+    readIds(d / "top.ids.png", &topIds, &TW, &TH);
+    csv(d / "spawn.ids.csv", W, spawnIds);
+    csv(d / "spawn.depth.csv", W, readPfm(d / "spawn.depth.pfm", W, H));
+    {
+        auto out = OIIO::ImageOutput::create((d / "top.ids.exr").string());
+        ASSERT_TRUE(out->open((d / "top.ids.exr").string(), OIIO::ImageSpec(TW, TH, 1, OIIO::TypeDesc::FLOAT)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, topIds.data()));
+        out->close();
+        const std::vector<float> depth = readPfm(d / "top.depth.pfm", TW, TH);
+        auto out2 = OIIO::ImageOutput::create((d / "top.depth.exr").string());
+        ASSERT_TRUE(out2->open((d / "top.depth.exr").string(), OIIO::ImageSpec(TW, TH, 1, OIIO::TypeDesc::FLOAT)));
+        ASSERT_TRUE(out2->write_image(OIIO::TypeDesc::FLOAT, depth.data()));
+        out2->close();
+    }
+    edit(d, [](json &j) {
+        j["views"]["spawn"]["zbuffer"]["ids"] = "spawn.ids.csv";
+        j["views"]["spawn"]["zbuffer"]["depth"] = "spawn.depth.csv";
+        j["views"]["top"]["zbuffer"]["ids"] = "top.ids.exr";
+        j["views"]["top"]["zbuffer"]["depth"] = "top.depth.exr";
+    });
+    const kit::KitGrade g = grade(d);
+    EXPECT_EQ(g.score, 1.0) << describe(g);
+    EXPECT_EQ(g.images.size(), 6u);
+}
+
 TEST_F(BadSubmission, UnreadableSubmissionsFailEveryCheckWithTheReason) {
     const kit::KitGrade none = grade(dir_ / "nobody");
     EXPECT_NE(none.error.find("not a folder"), std::string::npos) << none.error;
@@ -697,7 +754,12 @@ TEST_F(BadSubmission, UnreadableSubmissionsFailEveryCheckWithTheReason) {
     std::ofstream(dir_ / "shape" / "submission.json") << R"({"format": "visaudit-submission/1", "views": []})";
     const kit::KitGrade shape = grade(dir_ / "shape");
     EXPECT_NE(shape.error.find("expected \"views\": {\"VIEW\": {...}}"), std::string::npos) << shape.error;
-    for (const kit::KitGrade *g : {&none, &empty, &syntax, &shape}) {
+    fs::create_directories(dir_ / "link");
+    fs::create_symlink(dir_ / "syntax" / "submission.json", dir_ / "link" / "submission.json");
+    const kit::KitGrade link = grade(dir_ / "link");
+    EXPECT_NE(link.error.find("submission.json: a link to a file outside the submission folder"), std::string::npos)
+        << link.error;
+    for (const kit::KitGrade *g : {&none, &empty, &syntax, &shape, &link}) {
         EXPECT_EQ(g->score, 0.0);
         EXPECT_EQ(g->passed, 0u);
         EXPECT_EQ(g->failed, 96u);
@@ -740,12 +802,14 @@ TEST_F(BadSubmission, BadImagesAndListsAreNamedFailures) {
         for (int y = 0; y < 64; ++y)
             for (int x = 0; x < 64; ++x) csv << (x == 3 && y == 2 ? "2.5" : "0") << (x == 63 ? "\n" : ",");
     }
+    fs::create_symlink(dir_ / "good" / "spawn.depth.pfm", d / "link.pfm");  // a link out of the folder
     edit(d, [](json &j) {
         j["views"]["spawn"]["zbuffer"]["ids"] = "small.png";
         j["views"]["spawn"]["painter"]["ids"] = "rgb.png";
         j["views"]["top"]["zbuffer"]["depth"] = "nan.pfm";
         j["views"]["top"]["zbuffer"]["ids"] = "half.csv";
         j["views"]["top"]["painter"]["ids"] = "../good/top.painter.png";
+        j["views"]["spawn"]["zbuffer"]["depth"] = "link.pfm";
         j["views"]["spawn"]["backface"]["kept"] = "abc";
         j["views"]["spawn"]["clip"]["polygons"][0] = json{{"id", 1}};
         j["views"]["top"]["zbuffer"]["histogram"] = json::array({1, "two"});
@@ -758,6 +822,7 @@ TEST_F(BadSubmission, BadImagesAndListsAreNamedFailures) {
         {{"top", "zbuffer.depth"}, "nan.pfm: NaN at pixel (7, 5); write +inf or 0 for background"},
         {{"top", "zbuffer.ids"}, "half.csv: 2.5 at pixel (3, 2) is not an id (1 + a triangle id, 0 for background)"},
         {{"top", "painter.ids"}, "'../good/top.painter.png' is not a file of the submission folder; name the image relative to it"},
+        {{"spawn", "zbuffer.depth"}, "'link.pfm' is not a file of the submission folder; name the image relative to it"},
         {{"spawn", "backface.kept"}, "not an array of ids: \"abc\""},
         {{"spawn", "clip.polygons"}, "polygons[0]: expected {\"id\": ID, \"vertices\": [[x, y, w, d], ...]}"},
         {{"top", "zbuffer.histogram"}, "not every entry is a number"},

@@ -590,7 +590,10 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
             ++r.unresolved;
         }
     };
-    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), classify);
+    // CGAL's cutoff (below it a range is scanned instead of split further): 1,000 instead of 10
+    // took 25-30% off this function on oa_thor views of 13,000-17,000 drawn triangles (thread CPU,
+    // best of 3, at 320x180 and 1920x1080; the same pairs).
+    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), classify, std::ptrdiff_t(1000));
     r.boundsDisjoint = r.pairs - boundsOverlap;
     r.ms = t0.ms();
     return r;
