@@ -107,7 +107,7 @@ bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std
         } else {
             c = disagreementColor(d);
         }
-        put(img, W, int(i % size_t(W)), int(i / size_t(W)), c);
+        img[3 * i] = c.r, img[3 * i + 1] = c.g, img[3 * i + 2] = c.b;  // row-major: pixel i at 3 i
     }
     const std::vector<LegendEntry> legend = {
         {disagreementColor(Disagreement::edge), "edge " + std::to_string(check.edge)},
