@@ -82,7 +82,8 @@ std::string shadowImageName(const ViewImageNames &names, size_t light, const Vie
 // ---- Images ------------------------------------------------------------------------------------
 // The threads OpenImageIO and its OpenEXR writer may use (as --threads: 0 = every core). Without
 // it the EXR writer runs a pool as large as the machine even for --threads 1.
-void setImageThreads(int threads);
+// `parallelWriters`: how many images may be written at once (analyze: one per view in flight).
+void setImageThreads(int threads, size_t parallelWriters = 1);
 // Writes BASE.depth.exr, BASE.depth.png, BASE.overdraw.png and BASE.ids.exr for one view into dir
 // (each to a temporary name in dir, then renamed). Needs view.buffer (width x height). On failure
 // returns false with the path and OpenImageIO's message.
