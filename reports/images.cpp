@@ -39,13 +39,14 @@
 namespace va {
 
 void setImageThreads(int threads, size_t parallelWriters) {
-    OIIO::attribute("threads", threads);
-    // OpenEXR's own pool compresses a file's blocks in parallel, which helps only a writer that is
-    // alone: when every thread writes a view's images of its own, the pool's hand-offs cost CPU
-    // (25% more per 1080p EXR, measured) and buy nothing, so each file is compressed in the
-    // writing thread (-1: no pool).
+    // OpenImageIO's and OpenEXR's own pools convert and compress a file's blocks in parallel, which
+    // helps only a writer that is alone: when every thread writes a view's images of its own, the
+    // pools' hand-offs cost CPU (25% more per 1080p EXR, measured) and buy nothing, so each file
+    // is converted and compressed in the writing thread (threads 1, exr_threads -1: no pool).
     const int cores = threads > 0 ? threads : int(std::thread::hardware_concurrency());
-    OIIO::attribute("exr_threads", parallelWriters >= size_t(std::max(cores, 1)) ? -1 : threads);
+    const bool alone = parallelWriters < size_t(std::max(cores, 1));
+    OIIO::attribute("threads", alone ? threads : 1);
+    OIIO::attribute("exr_threads", alone ? threads : -1);
 }
 
 namespace {
