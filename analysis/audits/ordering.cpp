@@ -275,7 +275,8 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
     // Per split source, the trie of its drawn pieces.
     std::unordered_map<uint32_t, PieceTrie> tries;
     for (size_t k = 0; k < items.size(); ++k)
-        if (constrained(items[k])) tries[items[k].source].insert(*tree, items[k].piece, uint32_t(k));
+        if (constrained(items[k]) && fragmentsOf(items[k].source).first < fragmentsOf(items[k].source).second)
+            tries[items[k].source].insert(*tree, items[k].piece, uint32_t(k));  // sources with fragments only
 
     // Per split piece its fragment count, then the lists in item order (counting sort: each
     // source's fragments in ascending order into their owners' slots). Per cache fragment of a
@@ -298,7 +299,8 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
         const DrawItem &it = items[k];
         if (!constrained(it)) continue;
         sel.listed[k] = 1;
-        if (tries.at(it.source).direct) {
+        const auto trie = tries.find(it.source);
+        if (trie != tries.end() && trie->second.direct) {
             const auto [f0, f1] = fragmentsOf(it.source);
             std::vector<uint32_t> &list = directLists[k];
             for (uint64_t f = f0; f < f1; ++f)
