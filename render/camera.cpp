@@ -112,26 +112,8 @@ ViewRay viewRayThroughPixel(const Camera &cam, double px, double py) {
 //   orthographic: o = (x_n/sx, y_n/sy, 0), r = (0,0,-1): n.o - nz d + k = 0, so
 //     d = (nx x_n/sx + ny y_n/sy + k)/nz, affine in (px, py).
 DepthPlane depthPlaneFromView(const Camera &cam, Vec3 v0, Vec3 v1, Vec3 v2) {
-    const Vec3 n = cross(v1 - v0, v2 - v0);
-    const double k = -dot(n, v0);
-    const double W = cam.width, H = cam.height;
-    // x_n/sx = (2/W px - 1)/sx; y_n/sy = (1 - 2/H py)/sy
-    const double ax = 2 / (W * cam.sx), bx = -1 / cam.sx;  // x_n/sx = ax px + bx
-    const double ay = -2 / (H * cam.sy), by = 1 / cam.sy;  // y_n/sy = ay py + by
-    DepthPlane p;
-    if (cam.orthographic) {
-        if (!(n.z != 0) || !std::isfinite(k)) return p;
-        p.a = n.x * ax / n.z;
-        p.b = n.y * ay / n.z;
-        p.c = (n.x * bx + n.y * by + k) / n.z;
-    } else {
-        if (!(k != 0) || !std::isfinite(k)) return p;
-        p.a = -n.x * ax / k;
-        p.b = -n.y * ay / k;
-        p.c = -(n.x * bx + n.y * by - n.z) / k;
-    }
-    p.valid = std::isfinite(p.a) && std::isfinite(p.b) && std::isfinite(p.c);
-    return p;
+    // x_n/sx = (2/W px - 1)/sx; y_n/sy = (1 - 2/H py)/sy (DepthPlaneMaker, camera.h).
+    return DepthPlaneMaker(cam)(v0, v1, v2);
 }
 
 }  // namespace va

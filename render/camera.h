@@ -65,6 +65,33 @@ struct DepthPlane {
     bool valid = false;
 };
 DepthPlane depthPlaneFromView(const Camera &cam, Vec3 v0, Vec3 v1, Vec3 v2);  // view-space vertices
+// The same for many triangles of one camera: the pixel-to-view-plane constants (four divisions)
+// computed once, the plane of each triangle inline; bit-identical to depthPlaneFromView.
+struct DepthPlaneMaker {
+    explicit DepthPlaneMaker(const Camera &cam)
+        : orthographic(cam.orthographic), ax(2 / (double(cam.width) * cam.sx)), bx(-1 / cam.sx),
+          ay(-2 / (double(cam.height) * cam.sy)), by(1 / cam.sy) {}
+    DepthPlane operator()(Vec3 v0, Vec3 v1, Vec3 v2) const {
+        const Vec3 n = cross(v1 - v0, v2 - v0);
+        const double k = -dot(n, v0);
+        DepthPlane p;
+        if (orthographic) {
+            if (!(n.z != 0) || !std::isfinite(k)) return p;
+            p.a = n.x * ax / n.z;
+            p.b = n.y * ay / n.z;
+            p.c = (n.x * bx + n.y * by + k) / n.z;
+        } else {
+            if (!(k != 0) || !std::isfinite(k)) return p;
+            p.a = -n.x * ax / k;
+            p.b = -n.y * ay / k;
+            p.c = -(n.x * bx + n.y * by - n.z) / k;
+        }
+        p.valid = std::isfinite(p.a) && std::isfinite(p.b) && std::isfinite(p.c);
+        return p;
+    }
+    bool orthographic;
+    double ax, bx, ay, by;  // x_n/sx = ax px + bx, y_n/sy = ay py + by
+};
 inline double evalDepthPlane(const DepthPlane &p, double px, double py) { return (p.a * px + p.b * py) + p.c; }
 inline double viewDepthAt(const Camera &cam, const DepthPlane &p, double px, double py) {
     const double v = evalDepthPlane(p, px, py);

@@ -101,7 +101,7 @@ int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, Cli
 // their outcodes; s*: their projected fixed-point positions (read only when the triangle is
 // accepted whole, i.e. every corner is inside near, far and the guard band). Inlined into both
 // entry points, so clipTriangles' loop is what it was.
-[[gnu::always_inline]] inline void clipOne(const Camera &cam, const ClipSpace &cs, uint32_t t, const Vec3 &v0,
+[[gnu::always_inline]] inline void clipOne(const DepthPlaneMaker &planeOf, const ClipSpace &cs, uint32_t t, const Vec3 &v0,
                                            const Vec3 &v1, const Vec3 &v2, const ClipVertex *cv0,
                                            const ClipVertex *cv1, const ClipVertex *cv2, uint32_t c0, uint32_t c1,
                                            uint32_t c2, const int32_t *s0, const int32_t *s1, const int32_t *s2,
@@ -111,7 +111,7 @@ int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, Cli
         ++st.trivialRejected;
         return;
     }
-    const DepthPlane plane = depthPlaneFromView(cam, v0, v1, v2);
+    const DepthPlane plane = planeOf(v0, v1, v2);
     if (!plane.valid) {
         ++st.edgeOn;
         return;
@@ -198,6 +198,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     ScreenTriangles &out = r.out;
 
     const ClipSpace cs = clipSpaceOf(cam, settings);
+    const DepthPlaneMaker planeOf(cam);
 
     size_t total = 0;
     for (const ClipBatch &b : batches) total += b.count;
@@ -238,7 +239,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
             const uint32_t i1 = mesh.indices[3 * size_t(t) + 1] - b.vertexBegin;
             const uint32_t i2 = mesh.indices[3 * size_t(t) + 2] - b.vertexBegin;
 
-            clipOne(cam, cs, t, view[i0], view[i1], view[i2], &cv[i0], &cv[i1], &cv[i2], code[i0], code[i1], code[i2],
+            clipOne(planeOf, cs, t, view[i0], view[i1], view[i2], &cv[i0], &cv[i1], &cv[i2], code[i0], code[i1], code[i2],
                     &screen[size_t(i0) * 2], &screen[size_t(i1) * 2], &screen[size_t(i2) * 2], st, out, nullptr);
         }
     }
@@ -249,6 +250,7 @@ ClipResult clipViewTriangles(const Camera &cam, const std::vector<Vec3> &view, c
                              const ClipSettings &settings, std::vector<ClipPolygon> *polygons) {
     ClipResult r;
     const ClipSpace cs = clipSpaceOf(cam, settings);
+    const DepthPlaneMaker planeOf(cam);
     const size_t n = std::min(view.size() / 3, source.size());
     r.stats.trianglesIn = n;
     for (size_t t = 0; t < n; ++t) {
@@ -261,7 +263,7 @@ ClipResult clipViewTriangles(const Camera &cam, const std::vector<Vec3> &view, c
             code[k] = cs.outcode(cv[k]);
             if ((code[k] & (kOutNear | kOutFar | kGuardBits)) == 0) cs.project(cv[k], &screen[2 * k]);
         }
-        clipOne(cam, cs, source[t], v[0], v[1], v[2], &cv[0], &cv[1], &cv[2], code[0], code[1], code[2], &screen[0],
+        clipOne(planeOf, cs, source[t], v[0], v[1], v[2], &cv[0], &cv[1], &cv[2], code[0], code[1], code[2], &screen[0],
                 &screen[2], &screen[4], r.stats, r.out, polygons);
     }
     return r;
