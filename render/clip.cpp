@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/clip_vertices.h"
 #include "render/large_pages.h"
 
 namespace va {
@@ -209,38 +210,41 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     reserveOnLargePages(out.plane, total);
     reserveOnLargePages(out.planes, total);
 
-    // Per-batch scratch: view-space position, clip vertex, outcode and (when inside the guard band
-    // and in front of near) the projected fixed-point position of every vertex of the batch.
-    std::vector<Vec3> view;
-    std::vector<ClipVertex> cv;
-    std::vector<uint32_t> code;
-    std::vector<int32_t> screen;
-    const Mat4 &vw = cam.viewFromWorld;
+    // Per batch, every vertex of its range through the vertex pass (clip_vertices.h: view-space
+    // position, outcode, projected fixed point; AVX2 where the CPU has it), then its triangles. The triangles of a
+    // batch are scattered over the index array, so each one's indices are prefetched 16 ahead.
+    clip_detail::VertexPassParams vp;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) vp.m[r][c] = cam.viewFromWorld.m[r][c];
+    vp.sx = cam.sx, vp.sy = cam.sy, vp.nearZ = cs.nearZ, vp.farZ = cs.farZ, vp.gx = cs.gx, vp.gy = cs.gy;
+    vp.halfW = cs.halfW, vp.halfH = cs.halfH, vp.orthographic = cam.orthographic;
+    const bool avx2 = __builtin_cpu_supports("avx2");
+    clip_detail::BatchVertices bv;
 
     for (const ClipBatch &b : batches) {
         const uint32_t nv = b.vertexEnd - b.vertexBegin;
-        view.resize(nv);
-        cv.resize(nv);
-        code.resize(nv);
-        screen.resize(size_t(nv) * 2);
-        for (uint32_t i = 0; i < nv; ++i) {
-            const Vec3 v = transformPoint(vw, mesh.positions[b.vertexBegin + i]);
-            view[i] = v;
-            const ClipVertex c = clipVertexOf(cam, v);
-            cv[i] = c;
-            code[i] = cs.outcode(c);
-            if ((code[i] & (kOutNear | kOutFar | kGuardBits)) == 0) cs.project(c, &screen[size_t(i) * 2]);
-        }
+        bv.resize(nv);
+        const Vec3 *pos = mesh.positions + b.vertexBegin;
+        if (avx2) clip_detail::transformVerticesAvx2(vp, pos, nv, bv);
+        else if (vp.orthographic) clip_detail::transformVerticesBody<true>(vp, pos, 0, nv, bv);
+        else clip_detail::transformVerticesBody<false>(vp, pos, 0, nv, bv);
 
         st.trianglesIn += b.count;
+        const uint32_t *idx = mesh.indices;
         for (uint32_t k = 0; k < b.count; ++k) {
             const uint32_t t = b.triangles[k];
-            const uint32_t i0 = mesh.indices[3 * size_t(t)] - b.vertexBegin;
-            const uint32_t i1 = mesh.indices[3 * size_t(t) + 1] - b.vertexBegin;
-            const uint32_t i2 = mesh.indices[3 * size_t(t) + 2] - b.vertexBegin;
-
-            clipOne(planeOf, cs, t, view[i0], view[i1], view[i2], &cv[i0], &cv[i1], &cv[i2], code[i0], code[i1], code[i2],
-                    &screen[size_t(i0) * 2], &screen[size_t(i1) * 2], &screen[size_t(i2) * 2], st, out, nullptr);
+            if (k + 16 < b.count) __builtin_prefetch(idx + 3 * size_t(b.triangles[k + 16]));
+            const uint32_t i0 = idx[3 * size_t(t)] - b.vertexBegin;
+            const uint32_t i1 = idx[3 * size_t(t) + 1] - b.vertexBegin;
+            const uint32_t i2 = idx[3 * size_t(t) + 2] - b.vertexBegin;
+            const Vec3 v0{bv.x[i0], bv.y[i0], bv.z[i0]}, v1{bv.x[i1], bv.y[i1], bv.z[i1]};
+            const Vec3 v2{bv.x[i2], bv.y[i2], bv.z[i2]};
+            // The clip-space corners are read only when the triangle is clipped (clipOne inlined).
+            const ClipVertex c0 = clipVertexOf(cam, v0), c1 = clipVertexOf(cam, v1), c2 = clipVertexOf(cam, v2);
+            const int32_t s0[2] = {bv.sx[i0], bv.sy[i0]}, s1[2] = {bv.sx[i1], bv.sy[i1]};
+            const int32_t s2[2] = {bv.sx[i2], bv.sy[i2]};
+            clipOne(planeOf, cs, t, v0, v1, v2, &c0, &c1, &c2, bv.code[i0], bv.code[i1], bv.code[i2], s0, s1, s2, st,
+                    out, nullptr);
         }
     }
     return r;

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "analysis/stages/backface.h"
@@ -10,6 +12,7 @@
 #include "analysis/stages/frustum.h"
 #include "analysis/pipeline.h"
 #include "render/camera.h"
+#include "render/clip_vertices.h"
 
 using namespace va;
 using namespace va::testing_util;
@@ -227,6 +230,65 @@ TEST(Clip, HugeTriangleIsClippedAtTheGuardBandAndCoversEverything) {
     EXPECT_EQ(r.clip.clipped, 1u);
     EXPECT_EQ(r.zbuffer.coveredPixels, 64u * 48u);
     EXPECT_EQ(r.zbuffer.fragments, 64u * 48u);
+}
+
+// The clipper's vertex pass with AVX2 (render/clip_avx2.cpp) gives the scalar pass's bits for
+// every vertex: in front, behind the eye, on the near plane, at the guard band's edges, huge
+// (saturating fixed point), infinite and NaN; perspective and orthographic; every batch length
+// mod 4 (the AVX2 pass ends with the scalar one).
+TEST(Clip, Avx2VertexPassEqualsScalarBitForBit) {
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU";
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+    for (bool ortho : {false, true}) {
+        clip_detail::VertexPassParams p{};
+        const double m[3][4] = {{0.8, 0.1, -0.59, 3.25}, {-0.2, 0.97, 0.12, -1.5}, {0.56, 0.2, 0.8, -7.125}};
+        std::memcpy(p.m, m, sizeof m);
+        p.sx = 1.7320508075688772, p.sy = 3.0792014356780038, p.nearZ = 0.1, p.farZ = 1000;
+        p.gx = 1 + 2048 / 960.0, p.gy = 1 + 2048 / 540.0, p.halfW = 960, p.halfH = 540, p.orthographic = ortho;
+        std::vector<Vec3> pos;
+        for (int i = 0; i < 4000; ++i) {
+            const double scale = std::ldexp(1.0, int(rng() % 80) - 20);  // 2^-20 .. 2^59
+            pos.push_back({u(rng) * scale, u(rng) * scale, u(rng) * scale});
+        }
+        for (double special : {0.0, -0.0, 0.1, 1e300, -1e300, inf, -inf, nan})
+            for (int k = 0; k < 3; ++k) {
+                Vec3 v{u(rng), u(rng), u(rng)};
+                (k == 0 ? v.x : k == 1 ? v.y : v.z) = special;
+                pos.push_back(v);
+            }
+        for (uint32_t n : {uint32_t(pos.size()), uint32_t(pos.size() - 1), uint32_t(pos.size() - 2),
+                           uint32_t(pos.size() - 3), 3u, 0u}) {
+            clip_detail::BatchVertices a, b;
+            a.resize(n), b.resize(n);
+            clip_detail::transformVerticesAvx2(p, pos.data(), n, a);
+            if (ortho) clip_detail::transformVerticesBody<true>(p, pos.data(), 0, n, b);
+            else clip_detail::transformVerticesBody<false>(p, pos.data(), 0, n, b);
+            for (uint32_t i = 0; i < n; ++i) {
+                ASSERT_EQ(std::memcmp(&a.x[i], &b.x[i], 8), 0) << i;
+                ASSERT_EQ(std::memcmp(&a.y[i], &b.y[i], 8), 0) << i;
+                ASSERT_EQ(std::memcmp(&a.z[i], &b.z[i], 8), 0) << i;
+                ASSERT_EQ(a.code[i], b.code[i]) << i << " ortho " << ortho;
+                ASSERT_EQ(a.sx[i], b.sx[i]) << i;
+                ASSERT_EQ(a.sy[i], b.sy[i]) << i;
+            }
+        }
+    }
+    // The scalar pass's outcode and fixed point are the clipper's own (ClipSpace::outcode, toFixed):
+    // a vertex inside the guard band projects as toFixed does.
+    clip_detail::VertexPassParams p{};
+    p.m[0][0] = p.m[1][1] = p.m[2][2] = 1;
+    p.sx = p.sy = 1, p.nearZ = 0.5, p.farZ = 10, p.gx = p.gy = 2, p.halfW = 32, p.halfH = 24;
+    clip_detail::BatchVertices b;
+    b.resize(3);
+    const Vec3 pos[3] = {{0.25, -0.5, -2}, {3, 0, -2}, {0, 0, -0.25}};
+    clip_detail::transformVerticesBody<false>(p, pos, 0, 3, b);
+    EXPECT_EQ(b.code[0], 0u);
+    EXPECT_EQ(b.sx[0], toFixed((0.25 / 2 + 1) * 32));
+    EXPECT_EQ(b.sy[0], toFixed((1 - -0.5 / 2) * 24));
+    EXPECT_EQ(b.code[1], clip_detail::outBit(kPlaneRight));  // x/w = 1.5: outside the view, inside the band
+    EXPECT_EQ(b.code[2], clip_detail::outBit(kPlaneNear));
 }
 
 TEST(Pipeline, ClosedMeshWithBackfaceCullingCoversEachPixelOnce) {
