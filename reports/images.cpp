@@ -1,5 +1,5 @@
-// Per-view images: PNGs through libpng (palette images, encodePng), OpenEXR and reading through
-// OpenImageIO (the only file that includes either's headers).
+// Per-view images: PNGs through libpng (palette images, encodePng), EXRs through OpenEXRCore
+// (writeExr), reading through OpenImageIO (the only file that includes these libraries' headers).
 //
 //   BASE.depth.exr     one FLOAT channel "Z": the visible fragment's view depth d (double rounded to
 //                      float); background (no fragment) = +inf, so "nothing" is never mistaken for a
@@ -25,6 +25,7 @@
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+#include <OpenEXR/openexr.h>
 #include <png.h>
 #include <zlib.h>
 
@@ -39,10 +40,10 @@
 namespace va {
 
 void setImageThreads(int threads, size_t parallelWriters) {
-    // OpenImageIO's and OpenEXR's own pools convert and compress a file's blocks in parallel, which
-    // helps only a writer that is alone: when every thread writes a view's images of its own, the
-    // pools' hand-offs cost CPU (25% more per 1080p EXR, measured) and buy nothing, so each file
-    // is converted and compressed in the writing thread (threads 1, exr_threads -1: no pool).
+    // Images are written without OpenImageIO (PNG: libpng, EXR: OpenEXRCore, each in the calling
+    // thread); its pools serve the reads (grade, diff). They decode a file's blocks in parallel,
+    // which helps only a reader that is alone: when every thread handles a view of its own, the
+    // pools' hand-offs cost CPU and buy nothing (threads 1, exr_threads -1: no pool).
     const int cores = threads > 0 ? threads : int(std::thread::hardware_concurrency());
     const bool alone = parallelWriters < size_t(std::max(cores, 1));
     OIIO::attribute("threads", alone ? threads : 1);
@@ -52,7 +53,6 @@ void setImageThreads(int threads, size_t parallelWriters) {
 namespace {
 
 using OIIO::ImageInput;
-using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
@@ -176,35 +176,97 @@ bool writePng(const std::string &path, int width, int height, int channels, cons
 }
 
 // ---- OpenEXR --------------------------------------------------------------------------------------
-// Encodes one image with OpenImageIO in memory, then writes the bytes (writeEncoded). OpenImageIO's
-// own file errors name no system reason ("Failed to write pixel data").
-bool writeExr(const std::string &path, const ImageSpec &spec, const void *pixels, std::string *err) {
-    auto fail = [&](const std::string &msg) {
-        if (err) *err = "cannot write image '" + path + "': " + msg;
+// One-channel scanline images through OpenEXRCore (OpenEXR 3's C API) with ZIP compression, each
+// chunk of 16 rows compressed here: OpenEXR's ZIP filter (the chunk's bytes split into the even and
+// the odd ones, then each byte replaced by its difference to the previous + 128, modulo 256) as two
+// loops the compiler vectorizes, then zlib at level 1. The same chunk bytes as OpenEXR's own
+// compressor at level 1 (which OpenImageIO used until issue 18) at about 60% of the time: its
+// filter loops byte by byte, and OpenImageIO converts scanline by scanline before it. A chunk that
+// would not shrink is stored as it is (the format's rule; the reader knows it by its size). The
+// header holds the required attributes only, so the file is the same in every run.
+struct ExrSink {
+    std::string bytes;
+    std::string error;
+};
+
+int64_t exrWrite(exr_const_context_t, void *user, const void *buffer, uint64_t size, uint64_t offset,
+                 exr_stream_error_func_ptr_t) {
+    std::string &b = static_cast<ExrSink *>(user)->bytes;
+    if (offset + size > b.size()) b.resize(offset + size);
+    std::memcpy(b.data() + offset, buffer, size);
+    return int64_t(size);
+}
+
+// The ZIP filter and zlib on `n` bytes; the compressed size, or 0 when zlib fails.
+size_t zipChunk(const uint8_t *raw, size_t n, std::vector<uint8_t> &split, std::vector<uint8_t> &filtered,
+                std::vector<uint8_t> &out) {
+    split.resize(n);
+    filtered.resize(n);
+    const size_t half = (n + 1) / 2;
+    uint8_t *__restrict even = split.data();
+    uint8_t *__restrict odd = split.data() + half;
+    for (size_t i = 0; i < n / 2; ++i) {
+        even[i] = raw[2 * i];
+        odd[i] = raw[2 * i + 1];
+    }
+    if (n & 1) even[n / 2] = raw[n - 1];
+    const uint8_t *__restrict t = split.data();
+    uint8_t *__restrict d = filtered.data();
+    if (n) d[0] = t[0];
+    for (size_t i = 1; i < n; ++i) d[i] = uint8_t(t[i] - t[i - 1] + 128);
+    uLongf size = compressBound(uLong(n));
+    out.resize(size);
+    if (compress2(out.data(), &size, filtered.data(), uLong(n), 1) != Z_OK) return 0;
+    return size;
+}
+
+// A width x height image of one 32-bit channel (`isFloat`: FLOAT, else UINT) named `channel`,
+// rows top to bottom, encoded in memory and written with writeEncoded.
+bool writeExr(const std::string &path, int width, int height, const char *channel, bool isFloat, const void *pixels,
+              std::string *err) {
+    ExrSink sink;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.user_data = &sink;
+    init.write_fn = exrWrite;
+    init.error_handler_fn = [](exr_const_context_t ctxt, exr_result_t code, const char *msg) {
+        void *user = nullptr;
+        if (exr_get_user_data(ctxt, &user) != EXR_ERR_SUCCESS || !user) return;
+        std::string &e = static_cast<ExrSink *>(user)->error;
+        if (e.empty()) e = std::string(exr_get_error_code_as_string(code)) + (msg ? std::string(": ") + msg : "");
+    };
+    exr_context_t ctx = nullptr;
+    int part = 0;
+    int32_t linesPerChunk = 0;
+    auto fail = [&](exr_result_t code) {
+        if (ctx) exr_finish(&ctx);
+        if (err)
+            *err = "cannot write image '" + path + "': OpenEXR: " +
+                   (sink.error.empty() ? std::string(exr_get_error_code_as_string(code)) : sink.error);
         return false;
     };
-    // OpenImageIO stamps OpenEXR files with the current time (capDate) unless DateTime is set; an
-    // empty DateTime keeps the files byte-identical across runs (docs/architecture.md: images are identical
-    // across runs, so CI can diff them).
-    ImageSpec stamped = spec;
-    if (!stamped.find_attribute("DateTime")) stamped.attribute("DateTime", "");
-    // zip at level 1 instead of OpenEXR's default: 8 ms instead of 14-24 ms per 1080p image of the
-    // benchmark (issue 8), files 13-23% larger. Lossless either way, and deterministic.
-    if (!stamped.find_attribute("compression")) stamped.attribute("compression", "zip:1");
-    auto out = ImageOutput::create("openexr");
-    if (!out) return fail("no OpenImageIO writer for openexr: " + OIIO::geterror());
-    OIIO::Filesystem::IOVecOutput encoded;
-    if (!out->supports("ioproxy") || !out->set_ioproxy(&encoded))
-        return fail("the OpenImageIO openexr writer cannot write to memory");
-    if (!out->open(path, stamped)) return fail(out->geterror());
-    if (!out->write_image(spec.format, pixels)) {
-        const std::string msg = out->geterror();
-        out->close();
-        return fail(msg);
+    exr_result_t rv = exr_start_write(&ctx, path.c_str(), EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, nullptr, EXR_STORAGE_SCANLINE, &part);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, width, height, EXR_COMPRESSION_ZIP);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_add_channel(ctx, part, channel, isFloat ? EXR_PIXEL_FLOAT : EXR_PIXEL_UINT,
+                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_get_scanlines_per_chunk(ctx, part, &linesPerChunk);
+    if (rv != EXR_ERR_SUCCESS) return fail(rv);
+    thread_local std::vector<uint8_t> split, filtered, compressed;
+    static_assert(std::endian::native == std::endian::little, "OpenEXR stores pixels little-endian");
+    const size_t row = size_t(width) * 4;  // one 32-bit channel: the rows as they are in memory
+    for (int y = 0; y < height; y += linesPerChunk) {
+        const uint8_t *raw = static_cast<const uint8_t *>(pixels) + size_t(y) * row;
+        const size_t n = size_t(std::min(linesPerChunk, height - y)) * row;
+        const size_t c = zipChunk(raw, n, split, filtered, compressed);
+        rv = c && c < n ? exr_write_scanline_chunk(ctx, part, y, compressed.data(), c)
+                        : exr_write_scanline_chunk(ctx, part, y, raw, n);
+        if (rv != EXR_ERR_SUCCESS) return fail(rv);
     }
-    if (!out->close()) return fail(out->geterror());
-    const std::vector<unsigned char> &bytes = encoded.buffer();
-    return writeEncoded(path, std::string(bytes.begin(), bytes.end()), err);
+    rv = exr_finish(&ctx);
+    if (rv != EXR_ERR_SUCCESS) return fail(rv);
+    return writeEncoded(path, sink.bytes, err);
 }
 
 // ---- Overdraw legend layout -------------------------------------------------------------------
@@ -255,9 +317,7 @@ bool writePngRgb8(const std::string &path, int width, int height, const uint8_t 
 
 bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
                     std::string *err) {
-    ImageSpec spec(width, height, 1, TypeDesc::UINT32);
-    spec.channelnames = {channel};
-    return writeExr(path, spec, values, err);
+    return writeExr(path, width, height, channel, false, values, err);
 }
 
 // ---- Color mappings ---------------------------------------------------------------------------
@@ -396,10 +456,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     if (want("depth_exr")) {
         std::vector<float> z(n);
         for (size_t i = 0; i < n; ++i) z[i] = float(zb.depth[i]);
-        ImageSpec spec(W, H, 1, TypeDesc::FLOAT);
-        spec.channelnames = {"Z"};
-        spec.z_channel = 0;
-        if (!writeExr(prefix + names.depthExr, spec, z.data(), err)) return false;
+        if (!writeExr(prefix + names.depthExr, W, H, "Z", true, z.data(), err)) return false;
     }
 
     // BASE.depth.png: log-scaled gray between the view's nearest and farthest finite depth.
@@ -449,9 +506,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     // BASE.ids.exr: 1 + visible source triangle index as UINT32 (OpenEXR's 32-bit unsigned pixel
     // type holds every id exactly, unlike a float channel, which would round ids above 2^24).
     if (want("ids_exr")) {
-        ImageSpec spec(W, H, 1, TypeDesc::UINT32);
-        spec.channelnames = {"id"};
-        if (!writeExr(prefix + names.idsExr, spec, zb.id.data(), err)) return false;
+        if (!writeExr(prefix + names.idsExr, W, H, "id", false, zb.id.data(), err)) return false;
     }
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
