@@ -84,13 +84,7 @@ struct ReferenceSink {
 constexpr double kFloatU = 0x1p-24;
 constexpr double gammaF(int n) { return n * kFloatU / (1 - n * kFloatU); }
 
-// A triangle seen from the camera: view-space vertices and the float-frame magnitudes the ray
-// caster's error depends on.
-struct ViewTriangle {
-    Vec3 P[3];           // view space
-    double M[3];         // |vertex - frame origin| + |eye - frame origin| (world units)
-    DepthPlane plane;
-};
+}  // namespace
 
 ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t) {
     ViewTriangle v;
@@ -103,6 +97,8 @@ ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
     v.plane = depthPlaneFromView(cam, v.P[0], v.P[1], v.P[2]);
     return v;
 }
+
+namespace {
 
 // The ray caster's depth error for triangle v at (px, py), depth d: the hit point's error across
 // the plane (vertices and ray origin rounded to float: sqrt(3) u M each; the intersection's own
@@ -358,7 +354,20 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
 // ---- Z-buffer against ray casting ---------------------------------------------------------------
 
 EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t, double px, double py) {
-    const ViewTriangle v = viewTriangle(scene, cam, rayOrigin, t);
+    return edgeDistance(viewTriangle(scene, cam, rayOrigin, t), cam, px, py);
+}
+
+const ViewTriangle &EdgeDistanceMemo::triangle(uint32_t t) {
+    if (id_[0] == t) return tri_[0];
+    if (id_[1] == t) return tri_[1];
+    const int slot = next_;
+    next_ ^= 1;
+    id_[slot] = t;
+    tri_[slot] = viewTriangle(scene_, cam_, rayOrigin_, t);
+    return tri_[slot];
+}
+
+EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, double py) {
     EdgeDistance out;
     // Orientation sign so that inside is positive: perspective, the sign of det[P0, P1, P2] (the
     // edge function of edge 01 at the ray towards P2 is det); orthographic, minus the sign of the
@@ -384,11 +393,14 @@ EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
     // lies in the plane through the eye and the edge, so no vertex is projected and vertices
     // behind the eye need no care), and affine in p, so its gradient is an exact difference and
     // f / |grad f| is the signed distance in pixels to the projected edge.
-    auto edgeF = [&](int i, int j, double x, double y) {
-        const ViewRay r = viewRayThroughPixel(cam, x, y);
+    // The rays through the pixel and its right and lower neighbours, and the vertices' distances
+    // from the pixel's ray origin, each computed once for the three edges.
+    auto edgeF = [&](int i, int j, const ViewRay &r) {
         return dot(cross(v.P[i] - r.origin, v.P[j] - r.origin), r.direction);
     };
     const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const ViewRay rx = viewRayThroughPixel(cam, px + 1, py), ry = viewRayThroughPixel(cam, px, py + 1);
+    const double q[3] = {length(v.P[0] - r.origin), length(v.P[1] - r.origin), length(v.P[2] - r.origin)};
     const double dl = length(r.direction);
     double minS = std::numeric_limits<double>::infinity(), minTol = kSnapEdgeTolerancePx;
     bool allAbove = true;  // every constraint >= -tolerance
@@ -403,10 +415,10 @@ EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
     };
     for (int k = 0; k < 3; ++k) {
         const int i = k, j = (k + 1) % 3;
-        const double f = edgeF(i, j, px, py);
-        const double gx = edgeF(i, j, px + 1, py) - f, gy = edgeF(i, j, px, py + 1) - f;
+        const double f = edgeF(i, j, r);
+        const double gx = edgeF(i, j, rx) - f, gy = edgeF(i, j, ry) - f;
         const double g = std::hypot(gx, gy);
-        const double qi = length(v.P[i] - r.origin), qj = length(v.P[j] - r.origin);
+        const double qi = q[i], qj = q[j];
         // The float ray caster's uncertainty of f (audit.h, kEmbreeEdgeOps).
         const double df =
             (gammaF(kEmbreeEdgeOps) * qi * qj + std::sqrt(3.0) * kFloatU * (v.M[i] * qj + v.M[j] * qi)) * dl;
@@ -445,15 +457,22 @@ EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
 
 Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin,
                                   int x, int y, uint32_t idA, uint32_t idB) {
+    EdgeDistanceMemo memo(scene, cam, rayOrigin);
+    return classifyDisagreement(memo, encoder, x, y, idA, idB);
+}
+
+Disagreement classifyDisagreement(EdgeDistanceMemo &memo, const DepthEncoder &encoder, int x, int y, uint32_t idA,
+                                  uint32_t idB) {
     if (idA == idB) return Disagreement::none;
+    const Camera &cam = memo.camera();
     const double px = x + 0.5, py = y + 0.5;
     // Edge: who covers this center is decided by rounding, in either method, for either triangle.
     for (uint32_t id : {idA, idB})
-        if (id && edgeDistance(scene, cam, rayOrigin, id - 1, px, py).nearEdge) return Disagreement::edge;
+        if (id && memo(id - 1, px, py).nearEdge) return Disagreement::edge;
     if (!idA || !idB) return Disagreement::genuine;
     // Tie: both triangles' depths at the center, from their depth planes in double.
-    const ViewTriangle a = viewTriangle(scene, cam, rayOrigin, idA - 1);
-    const ViewTriangle b = viewTriangle(scene, cam, rayOrigin, idB - 1);
+    const ViewTriangle a = memo.triangle(idA - 1);
+    const ViewTriangle b = memo.triangle(idB - 1);
     if (!a.plane.valid || !b.plane.valid) return Disagreement::genuine;
     const double da = viewDepthAt(cam, a.plane, px, py), db = viewDepthAt(cam, b.plane, px, py);
     if (depthKey(encoder, da) == depthKey(encoder, db)) return Disagreement::tie;
@@ -473,6 +492,7 @@ CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector
     c.pixels = n;
     c.cls.assign(n, uint8_t(Disagreement::none));
     constexpr size_t kExamples = 16;
+    EdgeDistanceMemo memo(scene, cam, rayOrigin);
     for (size_t i = 0; i < n; ++i) {
         const uint32_t a = zbufferIds[i], b = raycastIds[i];
         if (a == b) {
@@ -484,7 +504,7 @@ CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector
             continue;
         }
         const int x = int(i % size_t(cam.width)), y = int(i / size_t(cam.width));
-        const Disagreement k = classifyDisagreement(scene, cam, encoder, rayOrigin, x, y, a, b);
+        const Disagreement k = classifyDisagreement(memo, encoder, x, y, a, b);
         c.cls[i] = uint8_t(k);
         if (!a || !b) ++c.oneSidedBackground;
         switch (k) {

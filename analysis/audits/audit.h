@@ -236,4 +236,37 @@ struct EdgeDistance {
 };
 EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t, double px, double py);
 
+// A triangle seen from the camera: view-space vertices and the float-frame magnitudes the ray
+// caster's error depends on (rayOrigin: the ray caster's frame origin).
+struct ViewTriangle {
+    Vec3 P[3];    // view space
+    double M[3];  // |vertex - frame origin| + |eye - frame origin| (world units)
+    DepthPlane plane;
+};
+ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t);
+// edgeDistance from a triangle's view-space data (the same value as the call above).
+EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, double py);
+
+// edgeDistance over the disagreeing pixels of a view, which come in runs on the same one or two
+// triangles: the view-space data of the last two triangles asked is kept (the same values).
+class EdgeDistanceMemo {
+public:
+    EdgeDistanceMemo(const Scene &scene, const Camera &cam, Vec3 rayOrigin)
+        : scene_(scene), cam_(cam), rayOrigin_(rayOrigin) {}
+    EdgeDistance operator()(uint32_t t, double px, double py) { return edgeDistance(triangle(t), cam_, px, py); }
+    const ViewTriangle &triangle(uint32_t t);
+    const Camera &camera() const { return cam_; }
+
+private:
+    const Scene &scene_;
+    const Camera &cam_;
+    Vec3 rayOrigin_;
+    uint32_t id_[2] = {UINT32_MAX, UINT32_MAX};
+    ViewTriangle tri_[2];
+    int next_ = 0;
+};
+// classifyDisagreement through a memo (crossCheck's loop).
+Disagreement classifyDisagreement(EdgeDistanceMemo &memo, const DepthEncoder &encoder, int x, int y, uint32_t idA,
+                                  uint32_t idB);
+
 }  // namespace va

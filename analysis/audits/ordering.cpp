@@ -134,6 +134,7 @@ PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisib
     const size_t w = size_t(std::max(v.cam.width, 1));
     const size_t n = std::min(ids.size(), ref.id.size());
     const uint32_t *A = ids.data(), *B = ref.id.data();
+    EdgeDistanceMemo edgeAt(*v.scene, v.cam, v.cam.eye);
     for (size_t p = 0; p < n; ++p) {
         // Most pixels agree: blocks of 16 that agree whole are skipped by one vectorizable test.
         if ((p & 15) == 0 && p + 16 <= n) {
@@ -155,8 +156,7 @@ PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisib
         }
         // Within the coverage uncertainty of either triangle's boundary (the float frame of the
         // edge bound at the eye: the rasterizer's snapping dominates).
-        const bool edge = (a && edgeDistance(*v.scene, v.cam, v.cam.eye, a - 1, px, py).nearEdge) ||
-                          (b && edgeDistance(*v.scene, v.cam, v.cam.eye, b - 1, px, py).nearEdge);
+        const bool edge = (a && edgeAt(a - 1, px, py).nearEdge) || (b && edgeAt(b - 1, px, py).nearEdge);
         c.cls[p] = edge ? kOrderEdge : kOrderWrong;
         (edge ? c.edgePixels : c.wrongPixels)++;
     }
