@@ -104,18 +104,24 @@ namespace {
 // the plane (vertices and ray origin rounded to float: sqrt(3) u M each; the intersection's own
 // arithmetic: gamma(kEmbreeEdgeOps) of the magnitudes, t |D| and |Q|), turned into an error along
 // the ray by 1 / |n.D| (a grazing ray moves far along itself for a small move across the plane).
-double rayDepthError(const Camera &cam, const ViewTriangle &v, double px, double py, double d) {
-    const ViewRay r = viewRayThroughPixel(cam, px, py);
+// r: the ray through (px, py); q[i] = |P[i] - r.origin| (edgeDistance has both at hand).
+double rayDepthError(const ViewTriangle &v, const ViewRay &r, const double q[3], double d) {
     const Vec3 n = cross(v.P[1] - v.P[0], v.P[2] - v.P[0]);
     const double nl = length(n);
     double maxM = 0, maxQ = 0;
     for (int i = 0; i < 3; ++i) {
         maxM = std::max(maxM, v.M[i]);
-        maxQ = std::max(maxQ, length(v.P[i] - r.origin));
+        maxQ = std::max(maxQ, q[i]);
     }
     const double across = std::sqrt(3.0) * kFloatU * maxM + gammaF(kEmbreeEdgeOps) * (d * length(r.direction) + maxQ);
     const double cosine = nl > 0 ? std::fabs(dot(n, r.direction)) / nl : 0;
     return cosine > 0 ? across / cosine + kFloatU * d : std::numeric_limits<double>::infinity();
+}
+
+double rayDepthError(const Camera &cam, const ViewTriangle &v, double px, double py, double d) {
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const double q[3] = {length(v.P[0] - r.origin), length(v.P[1] - r.origin), length(v.P[2] - r.origin)};
+    return rayDepthError(v, r, q, d);
 }
 
 }  // namespace
@@ -434,7 +440,7 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, d
     const double pv = evalDepthPlane(v.plane, px, py);
     const double gp = std::hypot(v.plane.a, v.plane.b);
     const double d = cam.orthographic ? pv : 1 / pv;
-    const double dErr = std::isfinite(d) && d > 0 ? rayDepthError(cam, v, px, py, d) : 0;
+    const double dErr = std::isfinite(d) && d > 0 ? rayDepthError(v, r, q, d) : 0;
     for (int side = 0; side < 2; ++side) {
         const double limit = side == 0 ? cam.nearZ : cam.farZ;
         double s, tolValue;
