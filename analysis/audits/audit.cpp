@@ -504,7 +504,13 @@ CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector
         if (a == b) {
             ++c.agree;
             if (a && i < zbufferDepth.size() && i < raycastDepth.size() && zbufferDepth[i] > 0) {
-                const double rel = std::fabs(double(raycastDepth[i]) - zbufferDepth[i]) / zbufferDepth[i];
+                // The quotient only where it can raise the maximum M: a <= s = (M z)(1 - 2^-50), both
+                // products rounded, is below M z exactly (s <= M z (1 + u)^2 (1 - 4u) < M z when s is
+                // normal), so a / z < M and its rounding cannot exceed M. Most pixels skip the division.
+                const double z = zbufferDepth[i], diff = std::fabs(double(raycastDepth[i]) - z);
+                const double bound = (c.maxRelativeDepthDifference * z) * (1 - 0x1p-50);
+                if (diff == 0 || (bound >= std::numeric_limits<double>::min() && diff <= bound)) continue;
+                const double rel = diff / z;
                 if (std::isfinite(rel)) c.maxRelativeDepthDifference = std::max(c.maxRelativeDepthDifference, rel);
             }
             continue;
