@@ -528,6 +528,7 @@ struct PairTri {
     double zmin, zmax;            // view depth range over its clipped screen vertices
     double bx0, by0, bx1, by1;    // screen bounding rectangle (pixels)
     uint32_t src, rank;           // rank: position in the painter's order (lower = drawn first)
+    Vec3 v[3];                    // its world-space corners (the pair tests read them, not the scene)
 };
 
 // Projections disjoint: every screen triangle of a against every one of b separated by one of the
@@ -559,10 +560,10 @@ bool projectionsDisjoint(const ScreenTriangles &st, uint32_t a0, uint32_t a1, ui
 
 // Every vertex of triangle p on Q's plane or on the side `side` of it (side = +-1: the eye's side,
 // or the side away from it); false when the eye is in Q's plane (side 0).
-bool allOnSide(const Scene &s, const PlaneSide &planeOfQ, uint32_t p, int side) {
+bool allOnSide(const PlaneSide &planeOfQ, const PairTri &p, int side) {
     if (side == 0) return false;
     for (int i = 0; i < 3; ++i)
-        if (planeOfQ(vertexOf(s, p, i)) * side < 0) return false;
+        if (planeOfQ(p.v[i]) * side < 0) return false;
     return true;
 }
 
@@ -590,9 +591,15 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
             drawn = drawn || (a != 0 && (!v.singleSided[s] || a < 0));
         }
         if (!drawn) continue;
-        PairTri p{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                  std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-                  -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), s, rank};
+        PairTri p{std::numeric_limits<double>::infinity(),
+                  -std::numeric_limits<double>::infinity(),
+                  std::numeric_limits<double>::infinity(),
+                  std::numeric_limits<double>::infinity(),
+                  -std::numeric_limits<double>::infinity(),
+                  -std::numeric_limits<double>::infinity(),
+                  s,
+                  rank,
+                  {vertexOf(scene, s, 0), vertexOf(scene, s, 1), vertexOf(scene, s, 2)}};
         const DepthPlane &pl = planeOfSource(v, s);
         for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
             for (int i = 0; i < 3; ++i) {
@@ -631,7 +638,7 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
     // triangle instead of once per pair.
     std::vector<PlaneSide> planeOf;
     planeOf.reserve(n);
-    for (const PairTri &t : tris) planeOf.emplace_back(vertexOf(scene, t.src, 0), vertexOf(scene, t.src, 1), vertexOf(scene, t.src, 2));
+    for (const PairTri &t : tris) planeOf.emplace_back(t.v[0], t.v[1], t.v[2]);
     std::vector<int8_t> eyeSideOf(scene.triangleCount(), 0);
     for (const PairTri &t : tris) eyeSideOf[t.src] = int8_t(eyeSide(scene, v.cam, t.src));
     auto classify = [&](const Box &a, const Box &b) {
@@ -642,16 +649,16 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
         const uint32_t P = Pt.src, Q = Qt.src;
         const PlaneSide &planeP = planeOf[size_t(&Pt - tris.data())], &planeQ = planeOf[size_t(&Qt - tris.data())];
         const int eyeQ = eyeSideOf[Q], eyeP = eyeSideOf[P];
-        if (allOnSide(scene, planeQ, P, -eyeQ)) {
+        if (allOnSide(planeQ, Pt, -eyeQ)) {
             ++r.behindPlane;
-        } else if (allOnSide(scene, planeP, Q, eyeP)) {
+        } else if (allOnSide(planeP, Qt, eyeP)) {
             ++r.inFrontOfPlane;
         } else if (projectionsDisjoint(v.all, v.screenBegin[P], v.screenEnd[P], v.screenBegin[Q], v.screenEnd[Q])) {
             ++r.projectionsDisjoint;
-        } else if (allOnSide(scene, planeP, Q, -eyeP)) {  // Newell's swap: Q is the farther one
+        } else if (allOnSide(planeP, Qt, -eyeP)) {  // Newell's swap: Q is the farther one
             ++r.behindPlane;
             ++r.swapped;
-        } else if (allOnSide(scene, planeQ, P, eyeQ)) {
+        } else if (allOnSide(planeQ, Pt, eyeQ)) {
             ++r.inFrontOfPlane;
             ++r.swapped;
         } else {
