@@ -211,8 +211,10 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     reserveOnLargePages(out.planes, total);
 
     // Per batch, every vertex of its range through the vertex pass (clip_vertices.h: view-space
-    // position, outcode, projected fixed point; AVX2 where the CPU has it), then its triangles. The triangles of a
-    // batch are scattered over the index array, so each one's indices are prefetched 16 ahead.
+    // position, outcode, projected fixed point; AVX2 where the CPU has it), then its triangles. A
+    // batch's triangles are scattered over the index array: each one's indices are prefetched 16
+    // ahead. (clipViewTriangles keeps the per-vertex ClipSpace::outcode and project: the vertex pass
+    // does their operations in their order; AssignmentKit.AnswersEqualThePipelinesNumbers checks.)
     clip_detail::VertexPassParams vp;
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) vp.m[r][c] = cam.viewFromWorld.m[r][c];
