@@ -3,9 +3,10 @@
 // IEEE double operations (multiplies and adds apart, never fused; ordered, quiet comparisons as
 // C++'s < and >; the exact conversion of an integer-valued double), so the bits are the same; the
 // last n % 4 vertices take the scalar body. clip.cpp calls it only when the CPU has AVX2.
-#include <immintrin.h>
-
 #include "render/clip_vertices.h"
+
+#if defined(__AVX2__)
+#include <immintrin.h>
 
 namespace va::clip_detail {
 
@@ -96,3 +97,12 @@ void transformVerticesAvx2(const VertexPassParams &p, const Vec3 *pos, uint32_t 
 }
 
 }  // namespace va::clip_detail
+#else
+namespace va::clip_detail {
+// Built without -mavx2 (not an x86-64 compiler): the scalar pass.
+void transformVerticesAvx2(const VertexPassParams &p, const Vec3 *pos, uint32_t n, BatchVertices &bv) {
+    if (p.orthographic) transformVerticesBody<true>(p, pos, 0, n, bv);
+    else transformVerticesBody<false>(p, pos, 0, n, bv);
+}
+}  // namespace va::clip_detail
+#endif

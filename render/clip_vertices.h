@@ -36,7 +36,9 @@ struct BatchVertices {
 
 // toFixed (raster.h) as selects instead of branches: the same value for every input (NaN and
 // -inf to INT32_MIN, +inf and anything at or beyond 2^31 to the ends).
-[[gnu::always_inline]] inline int32_t toFixedSelect(double pixelCoordinate) {
+// (static, as the pass below: clip_avx2.cpp compiles this header with -mavx2, and an inline
+// function shared by both files could be linked in its AVX2 build for the baseline's callers.)
+[[gnu::always_inline]] static inline int32_t toFixedSelect(double pixelCoordinate) {
     const double x = pixelCoordinate * kSubpixelOne;
     constexpr double kRound = 0x1.8p52;
     const double r = (x + kRound) - kRound;
@@ -49,7 +51,7 @@ struct BatchVertices {
 // The pass over vertices [begin, end) of a batch (pos: the batch's first). Per vertex: transformPoint (math.h) with the
 // same products and sums, clipVertexOf and ClipSpace::outcode and ClipSpace::project (clip.cpp).
 template <bool kOrtho>
-[[gnu::always_inline]] inline void transformVerticesBody(const VertexPassParams &p, const Vec3 *pos, size_t begin,
+[[gnu::always_inline]] static inline void transformVerticesBody(const VertexPassParams &p, const Vec3 *pos, size_t begin,
                                                          size_t end, BatchVertices &bv) {
     const double m00 = p.m[0][0], m01 = p.m[0][1], m02 = p.m[0][2], m03 = p.m[0][3];
     const double m10 = p.m[1][0], m11 = p.m[1][1], m12 = p.m[1][2], m13 = p.m[1][3];
