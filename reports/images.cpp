@@ -11,8 +11,6 @@
 //   BASE.ids.exr       one UINT32 channel "id": 1 + the visible source triangle index, 0 = background.
 #include <unistd.h>
 
-#include <thread>
-
 #include <algorithm>
 #include <bit>
 #include <optional>
@@ -39,15 +37,9 @@
 
 namespace va {
 
-void setImageThreads(int threads, size_t parallelWriters) {
-    // Images are written without OpenImageIO (PNG: libpng, EXR: OpenEXRCore, each in the calling
-    // thread); its pools serve the reads (grade, diff). They decode a file's blocks in parallel,
-    // which helps only a reader that is alone: when every thread handles a view of its own, the
-    // pools' hand-offs cost CPU and buy nothing (threads 1, exr_threads -1: no pool).
-    const int cores = threads > 0 ? threads : int(std::thread::hardware_concurrency());
-    const bool alone = parallelWriters < size_t(std::max(cores, 1));
-    OIIO::attribute("threads", alone ? threads : 1);
-    OIIO::attribute("exr_threads", alone ? threads : -1);
+void setImageThreads(int threads) {
+    OIIO::attribute("threads", threads);
+    OIIO::attribute("exr_threads", threads);
 }
 
 namespace {

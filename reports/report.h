@@ -80,13 +80,13 @@ ViewImageNames viewImageNames(const std::string &baseName);
 std::string shadowImageName(const ViewImageNames &names, size_t light, const ViewResult &view);
 
 // ---- Images ------------------------------------------------------------------------------------
-// The threads OpenImageIO and its OpenEXR writer may use (as --threads: 0 = every core). Without
-// it the EXR writer runs a pool as large as the machine even for --threads 1.
-// `parallelWriters`: how many images may be written at once (analyze: one per view in flight).
-void setImageThreads(int threads, size_t parallelWriters = 1);
+// The threads OpenImageIO's readers may use (as --threads: 0 = every core); without it its EXR
+// reader runs a pool as large as the machine even for --threads 1. (Images are written without
+// OpenImageIO, each in the calling thread.)
+void setImageThreads(int threads);
 // Writes BASE.depth.exr, BASE.depth.png, BASE.overdraw.png and BASE.ids.exr for one view into dir
-// (each to a temporary name in dir, then renamed). Needs view.buffer (width x height). On failure
-// returns false with the path and OpenImageIO's message.
+// (writeFileAtomic: in place inside a report's staging folder, elsewhere a temporary name renamed).
+// Needs view.buffer (width x height). On failure returns false with the path and the reason.
 bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
                      std::string *err, ImageSet set = ImageSet::all);
 // As above with baseName = sanitizeFileName(view name): for a single view only; use

@@ -262,18 +262,8 @@ struct PieceTrie {
         if (leaf.plane != UINT32_MAX || leaf.item != UINT32_MAX) direct = true;
         leaf.item = item;
     }
-    uint32_t owner(const BspViewPlanes &planes, Vec3 pv) const {
-        int32_t at = 0;
-        while (nodes[size_t(at)].plane != UINT32_MAX) {
-            const double *q = &planes.plane[4 * size_t(nodes[size_t(at)].plane)];
-            const bool front = (q[0] * pv.x + q[1] * pv.y + q[2] * pv.z) + q[3] >= 0;
-            at = nodes[size_t(at)].child[front ? 1 : 0];
-            if (at < 0) return UINT32_MAX;
-        }
-        return nodes[size_t(at)].item;
-    }
     // After the last insert: a missing child becomes a leaf owned by no item, so that a descent
-    // needs no test for it (owner2).
+    // needs no test for it.
     void seal() {
         const int32_t none = int32_t(nodes.size());
         nodes.push_back(Node{});
@@ -282,8 +272,10 @@ struct PieceTrie {
                 for (int32_t &c : n.child)
                     if (c < 0) c = none;
     }
-    // owner() of two points at once (sealed tries): their descents are independent chains of
-    // loads and sums, so interleaving them lets one run while the other waits. The same sums.
+    // The pieces owning two points (sealed tries; UINT32_MAX: none), each descending from the root
+    // with the sign of (q0 x + q1 y + q2 z) + q3 of each plane on its path, the expression of
+    // bspPieceContains. The two descents are independent chains of loads and sums, so interleaving
+    // them lets one run while the other waits.
     void owner2(const BspViewPlanes &planes, Vec3 p0, Vec3 p1, uint32_t *k0, uint32_t *k1) const {
         int32_t a = 0, b = 0;
         for (;;) {
@@ -354,7 +346,9 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
             tally(k1);
         }
         if (f < f1) {
-            const uint32_t k = trie.owner(*planes, rays.point(fc.pixel[f], fc.depth[f]));
+            const Vec3 p = rays.point(fc.pixel[f], fc.depth[f]);
+            uint32_t k, same;
+            trie.owner2(*planes, p, p, &k, &same);
             owner[f] = k;
             tally(k);
         }
