@@ -20,8 +20,9 @@
 //     Returning false skips the triangle (no fragment, no endTriangle).
 //   * Then `sink.fragment(size_t pixel, size_t t, double d)` for every covered center, pixel =
 //     y * width + x, with d bit-identical to viewDepthAt(plane, x + 0.5, y + 0.5) (the same IEEE
-//     operations, never stepped). Within a triangle the order of fragments is unspecified (it
-//     depends on the coverage path); no pixel is visited twice for one triangle.
+//     operations, never stepped). Within a triangle fragments come in ascending pixel order (rows
+//     downwards, each row left to right, on every coverage path); no pixel is visited twice for
+//     one triangle. The ordering audit's banded draws rely on the order (analysis/audits/ordering.cpp).
 //   * Then `sink.endTriangle(size_t t, uint64_t fragments)` with the number of fragment() calls
 //     made for it (possibly 0: a sub-pixel triangle between centers).
 //   Coverage is the top-left fill rule on pixel centers in fixed point (kSubpixelBits), exactly;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <unordered_map>
 
 #include <CGAL/box_intersection_d.h>
@@ -383,86 +384,194 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
     }
 }
 
-// The per-pixel results of a draw, and its counts. With the depth test the depth buffer is this
-// thread's scratch buffer, reused from draw to draw and view to view (a fresh 1080p buffer of
-// doubles cost more in page faults than the whole draw), and a pixel counts as covered when its
-// first fragment passes (from +inf: every finite depth passes, and id is never 0 once written);
+// Draws from the fragment cache, one band of rows at a time. Within a screen triangle the cache
+// holds fragments in ascending pixel order (forEachFragment's contract), so a band's fragments of a
+// triangle are a contiguous stretch of its range, and a triangle resumes in the next band where it
+// stopped. Each band draws its triangles in item order: a pixel sees its fragments in the same
+// order as a whole-screen draw, so the same counts and ids, while the band's depth buffer
+// (kBandRows rows of doubles) stays in the core's L2 instead of the random access into a 16 MB
+// buffer a whole-screen draw makes. Several draws of one view run band by band together, so the
+// band's fragments come from memory once for all of them (a view's cache is tens of megabytes,
+// and streaming it was the draws' cost once the depth buffer stayed near). With the depth test a
+// pixel counts as covered when its first fragment passes (from +inf every finite depth passes);
 // the id buffer is kept only when the caller wants it. Without the depth test every fragment
-// writes, and the ids are needed to count the covered pixels.
-template <bool kDepthTest>
-struct DrawTarget {
-    double *depth = nullptr;
-    std::vector<uint32_t> id;
-    bool keepIds;
-    uint64_t fragments = 0, passes = 0, covered = 0;
+// writes, and the ids count the covered pixels.
+constexpr size_t kBandRows = 16;
 
-    DrawTarget(size_t pixels, bool keepIds_) : keepIds(keepIds_) {
-        if constexpr (kDepthTest) {
-            thread_local std::vector<double> scratch;
-            scratch.assign(pixels, std::numeric_limits<double>::infinity());
-            depth = scratch.data();
+struct DrawJob {
+    const std::vector<DrawItem> *items = nullptr;
+    const ItemFragments *sel = nullptr;  // its listed items' fragments; null: every item whole
+    bool depthTest = false;
+    bool reverse = false;                // the items from the last to the first
+    std::vector<uint32_t> *idsOut = nullptr;
+    DrawStats stats;                     // out; stats.ms is this draw's own time
+};
+
+// A stretch of one item's fragments whose pixels ascend: a screen triangle's range of the cache
+// (`listed` = 0: cache indices at..end) or, for a split piece, its selected fragments of one screen
+// triangle (`listed` = 1: positions at..end of ItemFragments::index).
+struct DrawRun {
+    uint64_t at, end;
+    uint32_t current;   // 1 + source
+    uint32_t lastBand;  // the band of its last fragment
+    uint32_t listed;
+};
+
+// One draw's runs, per band the runs reaching it (in draw order), its band depth buffer and counts.
+struct BandedDraw {
+    std::vector<DrawRun> runs;
+    std::vector<uint32_t> firstBand, bandBegin, bandRuns;
+    std::vector<double> depth;  // one band's, indexed by pixel - the band's first pixel
+    std::vector<uint32_t> id;
+    uint64_t fragments = 0, passes = 0, covered = 0;
+    double ms = 0;
+
+    void prepare(const OrderingView &v, const DrawJob &job, size_t pixels, size_t bandPixels, size_t bands) {
+        const FragmentCache &fc = *v.fragments;
+        const std::vector<DrawItem> &items = *job.items;
+        runs.clear();
+        firstBand.clear();
+        fragments = passes = covered = 0;
+        auto addRun = [&](uint64_t at, uint64_t end, uint32_t current, uint32_t listed, uint32_t firstPixel,
+                          uint32_t lastPixel) {
+            runs.push_back({at, end, current, uint32_t(lastPixel / bandPixels), listed});
+            firstBand.push_back(uint32_t(firstPixel / bandPixels));
+        };
+        for (size_t j = 0; j < items.size(); ++j) {
+            const size_t k = job.reverse ? items.size() - 1 - j : j;
+            const uint32_t s = items[k].source, current = s + 1;
+            if (job.sel && job.sel->listed[k]) {
+                // The item's list ascends in cache index: split it at its screen triangles' bounds.
+                const uint32_t *index = job.sel->index.data();
+                uint64_t a = job.sel->begin[k];
+                const uint64_t e = job.sel->begin[k + 1];
+                for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s] && a < e; ++t) {
+                    const uint64_t b = uint64_t(std::lower_bound(index + a, index + e, fc.begin[t + 1]) - index);
+                    if (b > a) addRun(a, b, current, 1, fc.pixel[index[a]], fc.pixel[index[b - 1]]);
+                    a = b;
+                }
+            } else {
+                for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
+                    if (fc.begin[t + 1] > fc.begin[t])
+                        addRun(fc.begin[t], fc.begin[t + 1], current, 0, fc.pixel[fc.begin[t]],
+                               fc.pixel[fc.begin[t + 1] - 1]);
+            }
         }
-        if (!kDepthTest || keepIds) id.assign(pixels, 0);
+        bandBegin.assign(bands + 1, 0);
+        for (size_t r = 0; r < runs.size(); ++r)
+            for (uint32_t b = firstBand[r]; b <= runs[r].lastBand; ++b) ++bandBegin[b + 1];
+        for (size_t b = 0; b < bands; ++b) bandBegin[b + 1] += bandBegin[b];
+        bandRuns.resize(bandBegin[bands]);
+        std::vector<uint32_t> next(bandBegin.begin(), bandBegin.end() - 1);
+        for (size_t r = 0; r < runs.size(); ++r)
+            for (uint32_t b = firstBand[r]; b <= runs[r].lastBand; ++b) bandRuns[next[b]++] = uint32_t(r);
+        if (job.depthTest) depth.resize(bandPixels);
+        id.clear();
+        if (!job.depthTest || job.idsOut) id.resize(pixels, 0);
     }
-    void write(uint32_t pixel, double d, uint32_t current) {
-        ++fragments;
-        if constexpr (!kDepthTest) {
-            id[pixel] = current;
-            ++passes;
-        } else if (d < depth[pixel]) {
-            covered += depth[pixel] == std::numeric_limits<double>::infinity();
-            depth[pixel] = d;
-            if (keepIds) id[pixel] = current;
-            ++passes;
+
+    template <bool kDepthTest>
+    void drawBand(const FragmentCache &fc, const ItemFragments *sel, bool keepIds, uint32_t b, size_t p0, uint32_t p1) {
+        const uint32_t *pixelOf = fc.pixel.data();
+        const double *depthOf = fc.depth.data();
+        uint32_t *ids = id.data();
+        double *z = depth.data() - p0;  // indexed by the whole screen's pixel
+        if constexpr (kDepthTest) std::fill(depth.begin(), depth.end(), std::numeric_limits<double>::infinity());
+        uint64_t n = 0, pass = 0, cover = 0;
+        auto write = [&](uint32_t pixel, double d, uint32_t current) {
+            if constexpr (!kDepthTest) {
+                ids[pixel] = current;
+            } else if (d < z[pixel]) {
+                cover += z[pixel] == std::numeric_limits<double>::infinity();
+                z[pixel] = d;
+                if (keepIds) ids[pixel] = current;
+                ++pass;
+            }
+        };
+        for (uint32_t i = bandBegin[b]; i < bandBegin[b + 1]; ++i) {
+            DrawRun &run = runs[bandRuns[i]];
+            uint64_t f = run.at;
+            const uint64_t f0 = f;
+            const uint32_t current = run.current;
+            if (run.listed) {
+                const uint32_t *index = sel->index.data();
+                if (run.lastBand == b) {
+                    for (; f < run.end; ++f) write(pixelOf[index[f]], depthOf[index[f]], current);
+                } else {
+                    for (; pixelOf[index[f]] < p1; ++f) write(pixelOf[index[f]], depthOf[index[f]], current);
+                }
+            } else if (run.lastBand == b) {
+                for (; f < run.end; ++f) write(pixelOf[f], depthOf[f], current);
+            } else {
+                for (; pixelOf[f] < p1; ++f) write(pixelOf[f], depthOf[f], current);
+            }
+            n += f - f0;
+            run.at = f;
         }
+        fragments += n;
+        passes += pass;
+        covered += cover;
     }
-    DrawStats finish(std::vector<uint32_t> *idsOut) {
+
+    DrawStats finish(const DrawJob &job) {
         DrawStats st;
         st.fragments = fragments;
-        st.depthPasses = passes;
-        if constexpr (kDepthTest) {
+        if (job.depthTest) {
+            st.depthPasses = passes;
             st.coveredPixels = covered;
         } else {
+            st.depthPasses = fragments;
             for (uint32_t i : id) st.coveredPixels += i != 0;
         }
         st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
         st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
-        if (idsOut) *idsOut = std::move(id);
+        if (job.idsOut) *job.idsOut = std::move(id);
         return st;
     }
 };
 
-// A draw from the fragment cache: items in order, each one's fragments by `sel` when given, else
-// its source's screen triangles' ranges. The same fragments in the same item order as the
-// rasterizing draw (within a triangle the order is immaterial: no pixel twice), so the same result.
-template <bool kDepthTest>
-DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, const ItemFragments *sel,
-                     std::vector<uint32_t> *idsOut, bool reverse) {
+// The jobs' draws, band by band together; each job's stats.ms is the time of its own work.
+void drawCached(const OrderingView &v, std::span<DrawJob> jobs) {
     const FragmentCache &fc = *v.fragments;
-    DrawTarget<kDepthTest> target(size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0)),
-                                  idsOut != nullptr);
-    for (size_t j = 0; j < items.size(); ++j) {
-        const size_t k = reverse ? items.size() - 1 - j : j;
-        const uint32_t current = items[k].source + 1;
-        if (sel && sel->listed[k]) {
-            for (uint64_t j = sel->begin[k]; j < sel->begin[k + 1]; ++j) {
-                const uint32_t f = sel->index[j];
-                target.write(fc.pixel[f], fc.depth[f], current);
-            }
-        } else {
-            const uint32_t s = items[k].source;
-            for (uint64_t f = fc.begin[v.screenBegin[s]]; f < fc.begin[v.screenEnd[s]]; ++f)
-                target.write(fc.pixel[f], fc.depth[f], current);
+    const size_t width = size_t(std::max(v.cam.width, 0)), height = size_t(std::max(v.cam.height, 0));
+    const size_t pixels = width * height, bandPixels = kBandRows * width;
+    const size_t bands = width ? (height + kBandRows - 1) / kBandRows : 0;
+    thread_local std::vector<BandedDraw> draws;  // per job, storage reused from view to view
+    if (draws.size() < jobs.size()) draws.resize(jobs.size());
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        const Stopwatch t;
+        draws[j].prepare(v, jobs[j], pixels, bandPixels, bands);
+        draws[j].ms = t.ms();
+    }
+    for (size_t b = 0; b < bands; ++b) {
+        const size_t p0 = b * bandPixels;
+        const uint32_t p1 = uint32_t(std::min(pixels, p0 + bandPixels));
+        for (size_t j = 0; j < jobs.size(); ++j) {
+            const Stopwatch t;
+            const bool keepIds = jobs[j].idsOut != nullptr;
+            if (jobs[j].depthTest) draws[j].drawBand<true>(fc, jobs[j].sel, keepIds, uint32_t(b), p0, p1);
+            else draws[j].drawBand<false>(fc, jobs[j].sel, keepIds, uint32_t(b), p0, p1);
+            draws[j].ms += t.ms();
         }
     }
-    return target.finish(idsOut);
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        const Stopwatch t;
+        jobs[j].stats = draws[j].finish(jobs[j]);
+        jobs[j].stats.ms = draws[j].ms + t.ms();
+    }
 }
 
-// The items in order, or (reverse) from the last to the first.
+// One draw: the items in order, or (reverse) from the last to the first.
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
                      const ItemFragments *sel, std::vector<uint32_t> *idsOut, bool reverse = false) {
-    return depthTest ? drawCached<true>(v, items, sel, idsOut, reverse)
-                     : drawCached<false>(v, items, sel, idsOut, reverse);
+    DrawJob job;
+    job.items = &items;
+    job.sel = sel;
+    job.depthTest = depthTest;
+    job.reverse = reverse;
+    job.idsOut = idsOut;
+    drawCached(v, std::span<DrawJob>(&job, 1));
+    return job.stats;
 }
 
 bool hasConstrainedPiece(const std::vector<DrawItem> &items, const BspTree *tree) {
@@ -668,17 +777,13 @@ OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
     return r;
 }
 
-PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility &ref, PainterKey key,
-                                bool overlapTests) {
-    PainterResult r;
-    r.key = key;
-    const Stopwatch t0;
-    const std::vector<uint32_t> order = painterOrder(v, key);
-    r.sortMs = t0.ms();
-    std::vector<DrawItem> items(order.size());
-    for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
-    r.trianglesDrawn = order.size();
-    const DrawStats st = drawInOrder(v, items, false, nullptr, nullptr, &r.id);
+namespace {
+
+// The painter's draw of its `drawn` triangles done (its stats; its ids in r.id): the counts, the
+// comparison with the reference and, when asked, the overlap tests.
+void finishPainter(const OrderingView &v, const ReferenceVisibility &ref, PainterKey key, bool overlapTests,
+                   size_t drawn, const DrawStats &st, PainterResult &r) {
+    r.trianglesDrawn = drawn;
     r.drawMs = st.ms;
     r.fragments = st.fragments;
     r.coveredPixels = st.coveredPixels;
@@ -688,8 +793,23 @@ PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility
     r.tiePixels = c.tiePixels;
     r.edgePixels = c.edgePixels;
     r.cls = std::move(c.cls);
-    r.memoryBytes = r.id.size() * sizeof(uint32_t) + order.size() * (sizeof(double) + sizeof(uint32_t));
+    r.memoryBytes = r.id.size() * sizeof(uint32_t) + drawn * (sizeof(double) + sizeof(uint32_t));
     if (overlapTests) r.overlaps = painterOverlapTests(v, key);
+}
+
+}  // namespace
+
+PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility &ref, PainterKey key,
+                                bool overlapTests) {
+    PainterResult r;
+    r.key = key;
+    const Stopwatch t0;
+    const std::vector<uint32_t> order = painterOrder(v, key);
+    r.sortMs = t0.ms();
+    std::vector<DrawItem> items(order.size());
+    for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
+    const DrawStats st = drawInOrder(v, items, false, nullptr, nullptr, &r.id);
+    finishPainter(v, ref, key, overlapTests, order.size(), st, r);
     return r;
 }
 
@@ -712,13 +832,15 @@ BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, 
         thread_local ItemFragments sel;
         selectFragments(v, items, &tree, &planes, sel);
         const double selectMs = ts.ms() + v.fragments->rasterMs;
-        const Stopwatch tb;
-        r.backToFront = drawCached(v, items, false, &sel, &r.id);
-        r.backToFront.ms = tb.ms() + selectMs;
         // Front to back: the same items and lists, from the last to the first.
-        const Stopwatch tf;
-        r.frontToBack = drawCached(v, items, true, &sel, nullptr, true);
-        r.frontToBack.ms = tf.ms() + selectMs;
+        DrawJob jobs[2];
+        jobs[0] = {&items, &sel, false, false, &r.id, {}};
+        jobs[1] = {&items, &sel, true, true, nullptr, {}};
+        drawCached(v, jobs);
+        r.backToFront = jobs[0].stats;
+        r.backToFront.ms += selectMs;
+        r.frontToBack = jobs[1].stats;
+        r.frontToBack.ms += selectMs;
     } else {
         r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
         std::reverse(items.begin(), items.end());
@@ -766,22 +888,25 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     const OrderingView v = prepareOrderingView(scene, cam, &ref);
     const size_t pixels = size_t(std::max(cam.width, 0)) * size_t(std::max(cam.height, 0));
 
-    r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);
-    r.bsp = bspForView(v, ref, tree);
+    // The painter's draw and the overdraw by draw order (each with the depth test; the painter's
+    // order is also the back-to-front one). With the fragment cache the four draws run band by
+    // band together, and the submitted draw is also the z-buffer row below (kept ids).
     std::vector<uint32_t> submittedIds;
-
-    // Overdraw by draw order, each with the depth test.
     {
+        std::vector<DrawItem> backToFront;
+        if (v.fragments) {
+            r.painter.key = settings.painterKey;
+            const Stopwatch ts;
+            for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
+            r.painter.sortMs = ts.ms();
+        } else {
+            r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);
+            for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
+        }
+
         std::vector<DrawItem> submitted;
         for (size_t t = 0; t < v.all.size(); ++t)
             if (submitted.empty() || submitted.back().source != v.all.source[t]) submitted.push_back({v.all.source[t]});
-        // With the fragment cache this draw is also the z-buffer row below (kept ids).
-        r.overdrawByOrder.push_back(
-            {"submitted", drawInOrder(v, submitted, true, nullptr, nullptr, v.fragments ? &submittedIds : nullptr)});
-
-        std::vector<DrawItem> backToFront;
-        for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
-        r.overdrawByOrder.push_back({"back_to_front", drawInOrder(v, backToFront, true, nullptr, nullptr, nullptr)});
 
         // Front to back by object: objects by the view depth of their bounding sphere's center
         // (nearest first, ties by index), triangles of an object in submission order.
@@ -796,10 +921,26 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
                 const uint32_t s = scene.objectTriangles[i];
                 if (v.screenEnd[s] > v.screenBegin[s]) frontToBack.push_back({s});
             }
-        r.overdrawByOrder.push_back(
-            {"front_to_back_objects", drawInOrder(v, frontToBack, true, nullptr, nullptr, nullptr)});
-        r.overdrawByOrder.push_back({"bsp_front_to_back", r.bsp.frontToBack});
+
+        const char *names[3] = {"submitted", "back_to_front", "front_to_back_objects"};
+        const std::vector<DrawItem> *orders[3] = {&submitted, &backToFront, &frontToBack};
+        if (v.fragments) {
+            DrawJob jobs[4];
+            jobs[0] = {&backToFront, nullptr, false, false, &r.painter.id, {}};  // the painter's
+            for (int k = 0; k < 3; ++k)
+                jobs[k + 1] = {orders[k], nullptr, true, false, k == 0 ? &submittedIds : nullptr, {}};
+            drawCached(v, jobs);
+            for (DrawJob &j : jobs) j.stats.ms += v.fragments->rasterMs;
+            finishPainter(v, ref, settings.painterKey, settings.overlapTests, backToFront.size(), jobs[0].stats,
+                          r.painter);
+            for (int k = 0; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k + 1].stats});
+        } else {
+            for (int k = 0; k < 3; ++k)
+                r.overdrawByOrder.push_back({names[k], drawInOrder(v, *orders[k], true, nullptr, nullptr, nullptr)});
+        }
     }
+    r.bsp = bspForView(v, ref, tree);
+    r.overdrawByOrder.push_back({"bsp_front_to_back", r.bsp.frontToBack});
 
     // Scanline.
     r.scanline = scanlineVisibility(v.all, cam.width, cam.height, cam.orthographic, v.singleSided.data());
