@@ -813,44 +813,70 @@ PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility
     return r;
 }
 
-BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree) {
-    BspViewResult r;
+namespace {
+
+// The BSP's draw list for the view: the pieces back to front that have screen triangles (r gets
+// the traversal's time and the count); the planes of the view for the piece tests.
+BspViewPlanes bspItems(const OrderingView &v, const BspTree &tree, std::vector<DrawItem> &items, BspViewResult &r) {
     const Stopwatch t0;
     const std::vector<uint32_t> order = bspBackToFront(tree, *v.scene, v.cam);
-    const BspViewPlanes planes = bspViewPlanes(tree, *v.scene, v.cam);
+    BspViewPlanes planes = bspViewPlanes(tree, *v.scene, v.cam);
     r.traverseMs = t0.ms();
-    std::vector<DrawItem> items;
     items.reserve(order.size());
     for (uint32_t p : order)
         if (v.screenEnd[tree.pieces[p].source] > v.screenBegin[tree.pieces[p].source])
             items.push_back({tree.pieces[p].source, p});
     r.piecesDrawn = items.size();
-    if (v.fragments) {
-        // Both orders draw the same pieces' fragments: the piece test runs once, and each order's
-        // time is its own pass plus that selection plus the rasterization that recorded them.
-        const Stopwatch ts;
-        thread_local ItemFragments sel;
-        selectFragments(v, items, &tree, &planes, sel);
-        const double selectMs = ts.ms() + v.fragments->rasterMs;
-        // Front to back: the same items and lists, from the last to the first.
-        DrawJob jobs[2];
-        jobs[0] = {&items, &sel, false, false, &r.id, {}};
-        jobs[1] = {&items, &sel, true, true, nullptr, {}};
-        drawCached(v, jobs);
-        r.backToFront = jobs[0].stats;
-        r.backToFront.ms += selectMs;
-        r.frontToBack = jobs[1].stats;
-        r.frontToBack.ms += selectMs;
-    } else {
-        r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
-        std::reverse(items.begin(), items.end());
-        r.frontToBack = drawInOrder(v, items, true, &tree, &planes, nullptr);
-    }
+    return planes;
+}
+
+// With the fragment cache, both orders draw the same pieces' fragments: the piece test runs once
+// (its time and the rasterization's that recorded the fragments are returned, each order's time
+// being its own pass plus them), and front to back reads the same lists from the last item.
+double bspSelect(const OrderingView &v, const BspTree &tree, const BspViewPlanes &planes,
+                 const std::vector<DrawItem> &items, ItemFragments &sel) {
+    const Stopwatch ts;
+    selectFragments(v, items, &tree, &planes, sel);
+    return ts.ms() + v.fragments->rasterMs;
+}
+void bspJobs(const std::vector<DrawItem> &items, const ItemFragments &sel, BspViewResult &r, DrawJob *jobs) {
+    jobs[0] = {&items, &sel, false, false, &r.id, {}};
+    jobs[1] = {&items, &sel, true, true, nullptr, {}};
+}
+void bspTakeDraws(const DrawJob *jobs, double selectMs, BspViewResult &r) {
+    r.backToFront = jobs[0].stats;
+    r.backToFront.ms += selectMs;
+    r.frontToBack = jobs[1].stats;
+    r.frontToBack.ms += selectMs;
+}
+
+void bspCompare(const OrderingView &v, const ReferenceVisibility &ref, BspViewResult &r) {
     PixelComparison c = compareWithReference(v, ref, r.id);
     r.wrongPixels = c.wrongPixels;
     r.tiePixels = c.tiePixels;
     r.edgePixels = c.edgePixels;
     r.cls = std::move(c.cls);
+}
+
+}  // namespace
+
+BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree) {
+    BspViewResult r;
+    std::vector<DrawItem> items;
+    const BspViewPlanes planes = bspItems(v, tree, items, r);
+    if (v.fragments) {
+        thread_local ItemFragments sel;
+        const double selectMs = bspSelect(v, tree, planes, items, sel);
+        DrawJob jobs[2];
+        bspJobs(items, sel, r, jobs);
+        drawCached(v, jobs);
+        bspTakeDraws(jobs, selectMs, r);
+    } else {
+        r.backToFront = drawInOrder(v, items, false, &tree, &planes, &r.id);
+        std::reverse(items.begin(), items.end());
+        r.frontToBack = drawInOrder(v, items, true, &tree, &planes, nullptr);
+    }
+    bspCompare(v, ref, r);
     return r;
 }
 
@@ -888,9 +914,10 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     const OrderingView v = prepareOrderingView(scene, cam, &ref);
     const size_t pixels = size_t(std::max(cam.width, 0)) * size_t(std::max(cam.height, 0));
 
-    // The painter's draw and the overdraw by draw order (each with the depth test; the painter's
-    // order is also the back-to-front one). With the fragment cache the four draws run band by
-    // band together, and the submitted draw is also the z-buffer row below (kept ids).
+    // The painter's draw, the overdraw by draw order (each with the depth test; the painter's
+    // order is also the back-to-front one) and the BSP's two draws. With the fragment cache the
+    // six draws run band by band together, and the submitted draw is also the z-buffer row below
+    // (kept ids).
     std::vector<uint32_t> submittedIds;
     {
         std::vector<DrawItem> backToFront;
@@ -925,21 +952,31 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         const char *names[3] = {"submitted", "back_to_front", "front_to_back_objects"};
         const std::vector<DrawItem> *orders[3] = {&submitted, &backToFront, &frontToBack};
         if (v.fragments) {
-            DrawJob jobs[4];
+            std::vector<DrawItem> bspItemList;
+            thread_local ItemFragments bspSel;
+            double bspSelectMs;
+            {
+                const BspViewPlanes planes = bspItems(v, tree, bspItemList, r.bsp);
+                bspSelectMs = bspSelect(v, tree, planes, bspItemList, bspSel);
+            }
+            DrawJob jobs[6];
             jobs[0] = {&backToFront, nullptr, false, false, &r.painter.id, {}};  // the painter's
             for (int k = 0; k < 3; ++k)
                 jobs[k + 1] = {orders[k], nullptr, true, false, k == 0 ? &submittedIds : nullptr, {}};
+            bspJobs(bspItemList, bspSel, r.bsp, jobs + 4);
             drawCached(v, jobs);
-            for (DrawJob &j : jobs) j.stats.ms += v.fragments->rasterMs;
+            for (int k = 0; k < 4; ++k) jobs[k].stats.ms += v.fragments->rasterMs;
             finishPainter(v, ref, settings.painterKey, settings.overlapTests, backToFront.size(), jobs[0].stats,
                           r.painter);
             for (int k = 0; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k + 1].stats});
+            bspTakeDraws(jobs + 4, bspSelectMs, r.bsp);
+            bspCompare(v, ref, r.bsp);
         } else {
             for (int k = 0; k < 3; ++k)
                 r.overdrawByOrder.push_back({names[k], drawInOrder(v, *orders[k], true, nullptr, nullptr, nullptr)});
+            r.bsp = bspForView(v, ref, tree);
         }
     }
-    r.bsp = bspForView(v, ref, tree);
     r.overdrawByOrder.push_back({"bsp_front_to_back", r.bsp.frontToBack});
 
     // Scanline.
