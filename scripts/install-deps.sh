@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake pkg-config ca-certificates
   libopenmesh-dev libembree-dev libcgal-dev libgmp-dev libmpfr-dev
-  libopenimageio-dev libopenexr-dev libpng-dev zlib1g-dev nlohmann-json3-dev libcli11-dev libtbb-dev
+  libopenimageio-dev libopenexr-dev libpng-dev zlib1g-dev libdeflate-dev nlohmann-json3-dev libcli11-dev libtbb-dev
   libtinygltf-dev libstb-dev libzip-dev libdraco-dev libmeshoptimizer-dev assimp-utils
   libgtest-dev libgmock-dev libbenchmark-dev
   libegl-dev libopengl-dev libgl1-mesa-dri
