@@ -1,6 +1,8 @@
 // report.json against docs/report-schema.json, exact JSON values of a synthetic result, image
 // files read back through OpenImageIO, the bitmap font and the console funnel table.
 #include <gtest/gtest.h>
+#include <png.h>
+#include <zlib.h>
 
 #include <unistd.h>
 
@@ -13,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -822,6 +825,82 @@ TEST(ReportImages, PngPaletteUpTo256Colors) {
         EXPECT_EQ(d.width, W);
         EXPECT_EQ(d.height, H);
         EXPECT_TRUE(d.u8 == rgb) << colors << " colors: pixels differ after reading back";
+    }
+}
+
+// The PNG writer's own IDAT path (images above 16 KB of filtered rows) gives the bytes libpng
+// gives row by row with the same settings (filter "up", level 1, run-length strategy): palette
+// images (colors in order of first appearance, as the writer indexes them) and RGB ones, one-row,
+// one-column and wide images among them. Fails if a filter byte, the first row's filter, the zlib
+// header or trailer, or the IDAT chunking differs from libpng's.
+std::string libpngRows(int W, int H, const std::vector<uint8_t> &rgb) {
+    std::vector<png_color> palette;
+    std::map<uint32_t, uint8_t> indexOf;
+    std::vector<uint8_t> index;
+    bool usePalette = true;
+    for (size_t i = 0; i < size_t(W) * H && usePalette; ++i) {
+        const uint32_t k = uint32_t(rgb[3 * i]) | uint32_t(rgb[3 * i + 1]) << 8 | uint32_t(rgb[3 * i + 2]) << 16;
+        auto it = indexOf.find(k);
+        if (it == indexOf.end()) {
+            if (palette.size() == 256) {
+                usePalette = false;
+                break;
+            }
+            it = indexOf.emplace(k, uint8_t(palette.size())).first;
+            palette.push_back({rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]});
+        }
+        index.push_back(it->second);
+    }
+    std::string out;
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png_create_info_struct(png);
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return {};
+    }
+    png_set_write_fn(
+        png, &out,
+        [](png_structp p, png_bytep d, png_size_t n) {
+            static_cast<std::string *>(png_get_io_ptr(p))->append(reinterpret_cast<const char *>(d), n);
+        },
+        [](png_structp) {});
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
+    png_set_compression_strategy(png, Z_RLE);
+    png_set_compression_level(png, 1);
+    const int type = usePalette ? PNG_COLOR_TYPE_PALETTE : PNG_COLOR_TYPE_RGB;
+    png_set_IHDR(png, info, png_uint_32(W), png_uint_32(H), 8, type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    if (usePalette) png_set_PLTE(png, info, palette.data(), int(palette.size()));
+    png_write_info(png, info);
+    for (int y = 0; y < H; ++y)
+        png_write_row(png, usePalette ? &index[size_t(y) * W] : &rgb[size_t(y) * W * 3]);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return out;
+}
+
+TEST(ReportImages, PngDirectIdatEqualsLibpngRows) {
+    TempDir dir;
+    struct Case {
+        int W, H, colors;
+    };
+    for (const Case c : {Case{300, 200, 6}, Case{300, 200, 100000}, Case{20000, 1, 12}, Case{1, 20000, 12},
+                         Case{1920, 1080, 40}, Case{641, 480, 256}, Case{641, 480, 257}}) {
+        std::vector<uint8_t> rgb(size_t(c.W) * c.H * 3);
+        for (int y = 0; y < c.H; ++y)
+            for (int x = 0; x < c.W; ++x) {
+                // Bands of repeated rows and runs along each row, as the visualizations have.
+                const int yy = y - y % 7, xx = x - x % 13;
+                const uint32_t v = uint32_t((yy * 31 + xx * 17) * 2654435761u % uint32_t(c.colors)) * 40503u;
+                uint8_t *p = &rgb[(size_t(y) * c.W + x) * 3];
+                p[0] = uint8_t(v), p[1] = uint8_t(v >> 8), p[2] = uint8_t(v >> 16);
+            }
+        const std::string path = dir.path + "/d.png";
+        std::string err;
+        ASSERT_TRUE(writePngRgb8(path, c.W, c.H, rgb.data(), &err)) << err;
+        const std::string want = libpngRows(c.W, c.H, rgb);
+        ASSERT_FALSE(want.empty());
+        EXPECT_TRUE(fileBytes(path) == want) << c.W << "x" << c.H << ", " << c.colors << " colors";
     }
 }
 
