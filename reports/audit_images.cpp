@@ -118,13 +118,14 @@ bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std
     return writePngRgb8(path, W, CH, rgb.data(), err);
 }
 
-bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err) {
+bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err,
+                     ExrChunks *chunks) {
     if (width <= 0 || height <= 0 || ids.size() != size_t(width) * size_t(height)) {
         if (err) *err = "cannot write image '" + path + "': no " + std::to_string(width) + "x" + std::to_string(height) +
                         " ray-cast ids";
         return false;
     }
-    return writeExrUint32(path, width, height, ids.data(), "id", err);
+    return writeExrUint32(path, width, height, ids.data(), "id", err, chunks);
 }
 
 }  // namespace va

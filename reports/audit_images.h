@@ -43,7 +43,8 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
 // grays: the z-buffer depth's depthGrays when the caller has them (else computed here).
 bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err,
                            const std::vector<uint8_t> *grays = nullptr);
-// BASE.raycast.ids.exr.
-bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err);
+// BASE.raycast.ids.exr (chunks: as writeExrUint32's).
+bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err,
+                     ExrChunks *chunks = nullptr);
 
 }  // namespace va

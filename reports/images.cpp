@@ -303,7 +303,7 @@ size_t zipChunk(const uint8_t *raw, size_t n, std::vector<uint8_t> &split, std::
 // A width x height image of one 32-bit channel (`isFloat`: FLOAT, else UINT) named `channel`,
 // rows top to bottom, encoded in memory and written with writeEncoded.
 bool writeExr(const std::string &path, int width, int height, const char *channel, bool isFloat, const void *pixels,
-              std::string *err) {
+              std::string *err, ExrChunks *chunks = nullptr) {
     ExrSink sink;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.user_data = &sink;
@@ -336,14 +336,29 @@ bool writeExr(const std::string &path, int width, int height, const char *channe
     thread_local std::vector<uint8_t> split, filtered, compressed;
     static_assert(std::endian::native == std::endian::little, "OpenEXR stores pixels little-endian");
     const size_t row = size_t(width) * 4;  // one 32-bit channel: the rows as they are in memory
-    for (int y = 0; y < height; y += linesPerChunk) {
-        const uint8_t *raw = static_cast<const uint8_t *>(pixels) + size_t(y) * row;
+    // The chunks of the image written before, when it has this one's size and type.
+    const uint8_t *before = chunks && chunks->pixels && chunks->width == width && chunks->height == height &&
+                                    chunks->isFloat == isFloat
+                                ? static_cast<const uint8_t *>(chunks->pixels)
+                                : nullptr;
+    std::vector<std::vector<uint8_t>> written;
+    for (int y = 0, k = 0; y < height; y += linesPerChunk, ++k) {
+        const size_t at = size_t(y) * row;
+        const uint8_t *raw = static_cast<const uint8_t *>(pixels) + at;
         const size_t n = size_t(std::min(linesPerChunk, height - y)) * row;
-        const size_t c = zipChunk(raw, n, split, filtered, compressed);
-        rv = c && c < n ? exr_write_scanline_chunk(ctx, part, y, compressed.data(), c)
-                        : exr_write_scanline_chunk(ctx, part, y, raw, n);
+        std::vector<uint8_t> bytes;
+        if (before && size_t(k) < chunks->bytes.size() && std::memcmp(raw, before + at, n) == 0) {
+            bytes = std::move(chunks->bytes[size_t(k)]);
+        } else {
+            const size_t c = zipChunk(raw, n, split, filtered, compressed);
+            if (c && c < n) bytes.assign(compressed.begin(), compressed.begin() + ptrdiff_t(c));
+        }
+        rv = bytes.empty() ? exr_write_scanline_chunk(ctx, part, y, raw, n)
+                           : exr_write_scanline_chunk(ctx, part, y, bytes.data(), bytes.size());
         if (rv != EXR_ERR_SUCCESS) return fail(rv);
+        if (chunks) written.push_back(std::move(bytes));
     }
+    if (chunks) *chunks = ExrChunks{pixels, width, height, isFloat, std::move(written)};
     rv = exr_finish(&ctx);
     if (rv != EXR_ERR_SUCCESS) return fail(rv);
     return writeEncoded(path, sink.bytes, err);
@@ -396,8 +411,8 @@ bool writePngRgb8(const std::string &path, int width, int height, const uint8_t 
 }
 
 bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
-                    std::string *err) {
-    return writeExr(path, width, height, channel, false, values, err);
+                    std::string *err, ExrChunks *chunks) {
+    return writeExr(path, width, height, channel, false, values, err, chunks);
 }
 
 // ---- Color mappings ---------------------------------------------------------------------------
@@ -588,8 +603,9 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.ids.exr: 1 + visible source triangle index as UINT32 (OpenEXR's 32-bit unsigned pixel
     // type holds every id exactly, unlike a float channel, which would round ids above 2^24).
+    ExrChunks idChunks;  // the z-buffer's ids, for the ray caster's (mostly the same rows)
     if (want("ids_exr")) {
-        if (!writeExr(prefix + names.idsExr, W, H, "id", false, zb.id.data(), err)) return false;
+        if (!writeExr(prefix + names.idsExr, W, H, "id", false, zb.id.data(), err, &idChunks)) return false;
     }
 
     // BASE.zfight.png: the z-fighting hotspots (reports/zfight_image.h).
@@ -615,7 +631,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     // The raycast stage: its ids, and where it disagrees with the z-buffer (reports/audit_images.h).
     if (view.raycast.ran()) {
         const RaycastImage &image = view.raycast->image;
-        if (want("raycast_ids_exr") && !writeRaycastIds(image.width, image.height, image.id, prefix + names.raycastIdsExr, err))
+        if (want("raycast_ids_exr") && !writeRaycastIds(image.width, image.height, image.id, prefix + names.raycastIdsExr, err, &idChunks))
             return false;
         if (want("raycast_diff_png") && !writeRaycastDiffImage(zb, view.raycast->crossCheck, prefix + names.raycastDiffPng, err, zGrays()))
             return false;

@@ -185,10 +185,19 @@ bool writeFileAtomic(const std::string &path, const std::string &contents, std::
 // Images written the same way, for the other image writers of reports/: an interleaved RGB8 PNG
 // (libpng; stored with a palette when it has at most 256 colors, as every visualization here does:
 // the same pixels read back, a third of the bytes to compress), and a one-channel UINT32 EXR (ids,
-// OpenImageIO).
+// OpenEXRCore). `chunks`, when given, carries an EXR's compressed chunks from one write to the next:
+// a chunk whose rows are byte-identical to the same chunk of the image written before (same size
+// and type; its pixels must still be alive) is not compressed again (the z-buffer's and the ray
+// caster's ids agree on about half of them), and afterwards it holds this image's.
+struct ExrChunks {
+    const void *pixels = nullptr;  // the image they were written from
+    int width = 0, height = 0;
+    bool isFloat = false;
+    std::vector<std::vector<uint8_t>> bytes;  // per chunk: its compressed bytes; empty: stored as it is
+};
 bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err);
 bool writeExrUint32(const std::string &path, int width, int height, const uint32_t *values, const char *channel,
-                    std::string *err);
+                    std::string *err, ExrChunks *chunks = nullptr);
 
 // An output directory written as a whole or not at all: files go into a staging folder next to
 // the target, and commit() swaps it in. An existing target is replaced only if it is a visaudit

@@ -904,6 +904,36 @@ TEST(ReportImages, PngDirectIdatEqualsLibpngRows) {
     }
 }
 
+// An EXR written with the chunks of one written before reuses the chunks whose rows are the same
+// and compresses the others: byte for byte the file written without them (one changed pixel in
+// chunk 2, a different size, and a float image of the same size do not take the stale chunks).
+TEST(ReportImages, ExrChunksReusedOnlyWhereRowsAgree) {
+    TempDir dir;
+    const int W = 200, H = 90;  // 6 chunks of 16 rows
+    std::vector<uint32_t> a(size_t(W) * H), b;
+    for (size_t i = 0; i < a.size(); ++i) a[i] = uint32_t(i / 37 % 11 + 1);
+    b = a;
+    b[size_t(40) * W + 17] += 5;  // row 40: chunk 2
+    std::string err;
+    ExrChunks chunks;
+    ASSERT_TRUE(writeExrUint32(dir.path + "/a.exr", W, H, a.data(), "id", &err, &chunks)) << err;
+    EXPECT_EQ(chunks.bytes.size(), 6u);
+    ASSERT_TRUE(writeExrUint32(dir.path + "/b.exr", W, H, b.data(), "id", &err, &chunks)) << err;
+    ASSERT_TRUE(writeExrUint32(dir.path + "/b-alone.exr", W, H, b.data(), "id", &err)) << err;
+    EXPECT_TRUE(fileBytes(dir.path + "/b.exr") == fileBytes(dir.path + "/b-alone.exr"));
+    // Reusing b's chunks for a: chunk 2 differs again.
+    ASSERT_TRUE(writeExrUint32(dir.path + "/a2.exr", W, H, a.data(), "id", &err, &chunks)) << err;
+    EXPECT_TRUE(fileBytes(dir.path + "/a2.exr") == fileBytes(dir.path + "/a.exr"));
+    // A different height: nothing reused.
+    ASSERT_TRUE(writeExrUint32(dir.path + "/short.exr", W, H - 20, a.data(), "id", &err, &chunks)) << err;
+    ASSERT_TRUE(writeExrUint32(dir.path + "/short-alone.exr", W, H - 20, a.data(), "id", &err)) << err;
+    EXPECT_TRUE(fileBytes(dir.path + "/short.exr") == fileBytes(dir.path + "/short-alone.exr"));
+    ImageData d;
+    ASSERT_TRUE(readImage(dir.path + "/b.exr", &d, &err)) << err;
+    ASSERT_EQ(d.u32.size(), b.size());
+    EXPECT_TRUE(d.u32 == b);
+}
+
 TEST(ReportImages, Errors) {
     TempDir dir;
     std::string err;
