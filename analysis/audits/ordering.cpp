@@ -54,10 +54,8 @@ struct PixelRays {
             oy[size_t(y)] = r.origin.y, dy[size_t(y)] = r.direction.y;
         }
     }
-    Vec3 point(size_t pixel, double d) const {
-        const size_t x = pixel % width, y = pixel / width;
-        return {ox[x] + dx[x] * d, oy[y] + dy[y] * d, oz + dz * d};
-    }
+    Vec3 point(size_t pixel, double d) const { return point(pixel % width, pixel / width, d); }
+    Vec3 point(size_t x, size_t y, double d) const { return {ox[x] + dx[x] * d, oy[y] + dy[y] * d, oz + dz * d}; }
 };
 
 // The drawing sink: optional depth test (LESS on the double depth), optional piece filter.
@@ -273,27 +271,46 @@ struct PieceTrie {
                 for (int32_t &c : n.child)
                     if (c < 0) c = none;
     }
-    // The pieces owning two points (sealed tries; UINT32_MAX: none), each descending from the root
-    // with the sign of (q0 x + q1 y + q2 z) + q3 of each plane on its path, the expression of
-    // bspPieceContains. The two descents are independent chains of loads and sums, so interleaving
-    // them lets one run while the other waits.
-    void owner2(const BspViewPlanes &planes, Vec3 p0, Vec3 p1, uint32_t *k0, uint32_t *k1) const {
-        int32_t a = 0, b = 0;
-        for (;;) {
-            const Node &na = nodes[size_t(a)], &nb = nodes[size_t(b)];
-            const bool la = na.plane == UINT32_MAX, lb = nb.plane == UINT32_MAX;
-            if (la && lb) break;
-            if (!la) {
-                const double *q = &planes.plane[4 * size_t(na.plane)];
-                a = na.child[(q[0] * p0.x + q[1] * p0.y + q[2] * p0.z) + q[3] >= 0 ? 1 : 0];
-            }
-            if (!lb) {
-                const double *q = &planes.plane[4 * size_t(nb.plane)];
-                b = nb.child[(q[0] * p1.x + q[1] * p1.y + q[2] * p1.z) + q[3] >= 0 ? 1 : 0];
-            }
+    // The last descent's path: its planes and sides, and the piece it reached.
+    static constexpr int kMaxPath = 24;
+    struct Path {
+        const double *q[kMaxPath];
+        bool side[kMaxPath];
+        int length = -1;  // -1: none (or longer than kMaxPath)
+        uint32_t owner = UINT32_MAX;
+        // Whether p takes the same path: every plane on it gives the same side, so the descent
+        // would end in the same leaf. The planes are evaluated independently of one another (no
+        // chain of node loads), so they overlap in the pipeline.
+        bool holds(Vec3 p) const {
+            bool same = length >= 0;
+            for (int i = 0; i < length; ++i) same &= ((q[i][0] * p.x + q[i][1] * p.y + q[i][2] * p.z) + q[i][3] >= 0) == side[i];
+            return same;
         }
-        *k0 = nodes[size_t(a)].item;
-        *k1 = nodes[size_t(b)].item;
+    };
+    // The piece owning point p (sealed tries; UINT32_MAX: none): the last path's piece when p takes
+    // that path, else a descent from the root with the sign of (q0 x + q1 y + q2 z) + q3 of each
+    // plane on its way (the expression of bspPieceContains), recorded in `path`. Consecutive
+    // fragments mostly land in the same piece, and checking the known path's planes side by side
+    // costs less than the descent's chain of dependent loads and sums.
+    uint32_t owner(const BspViewPlanes &planes, Vec3 p, Path &path) const {
+        if (path.holds(p)) return path.owner;
+        int32_t a = 0;
+        int length = 0;
+        for (;;) {
+            const Node &n = nodes[size_t(a)];
+            if (n.plane == UINT32_MAX) break;
+            const double *q = &planes.plane[4 * size_t(n.plane)];
+            const bool side = (q[0] * p.x + q[1] * p.y + q[2] * p.z) + q[3] >= 0;
+            if (length < kMaxPath) {
+                path.q[length] = q;
+                path.side[length] = side;
+            }
+            ++length;
+            a = n.child[side ? 1 : 0];
+        }
+        path.length = length <= kMaxPath ? length : -1;
+        path.owner = nodes[size_t(a)].item;
+        return path.owner;
     }
 };
 
@@ -336,20 +353,19 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
             runOwner = k;
             run = 1;
         };
-        uint64_t f = f0;
-        for (; f + 2 <= f1; f += 2) {
-            uint32_t k0, k1;
-            trie.owner2(*planes, rays.point(fc.pixel[f], fc.depth[f]), rays.point(fc.pixel[f + 1], fc.depth[f + 1]), &k0,
-                        &k1);
-            owner[f] = k0;
-            owner[f + 1] = k1;
-            tally(k0);
-            tally(k1);
-        }
-        if (f < f1) {
-            const Vec3 p = rays.point(fc.pixel[f], fc.depth[f]);
-            uint32_t k, same;
-            trie.owner2(*planes, p, p, &k, &same);
+        PieceTrie::Path path;
+        // The pixel's column and row, stepped along a row (a division only where a row starts).
+        size_t x = 0, y = 0, last = SIZE_MAX - 1;
+        for (uint64_t f = f0; f < f1; ++f) {
+            const size_t pixel = fc.pixel[f];
+            if (pixel == last + 1 && x + 1 < rays.width) {
+                ++x;
+            } else {
+                x = pixel % rays.width;
+                y = pixel / rays.width;
+            }
+            last = pixel;
+            const uint32_t k = trie.owner(*planes, rays.point(x, y, fc.depth[f]), path);
             owner[f] = k;
             tally(k);
         }
