@@ -96,6 +96,12 @@ struct TwoNearestSink {
 TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic,
                           const uint8_t *singleSided) {
     TwoNearest r;
+    findTwoNearest(tris, width, height, orthographic, singleSided, r);
+    return r;
+}
+
+void findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic, const uint8_t *singleSided,
+                    TwoNearest &r) {
     r.width = std::max(width, 0);
     r.height = std::max(height, 0);
     const size_t n = size_t(r.width) * size_t(r.height);
@@ -103,10 +109,9 @@ TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bo
     r.depth2.assign(n, kInf);
     r.screen1.assign(n, kNoFragment);
     r.screen2.assign(n, kNoFragment);
-    if (n == 0) return r;
+    if (n == 0) return;
     TwoNearestSink sink{&r, tris.source.data(), singleSided};
     forEachFragment(tris, r.width, r.height, orthographic, sink);
-    return r;
 }
 
 // ---- Triangle pairs: common vertices, shared edge, coplanarity --------------------------------
@@ -816,7 +821,10 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     }
 
     // 1. Two nearest surfaces.
-    const TwoNearest two = findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided);
+    // This thread's buffers, reused from view to view: a fresh 1080p set (48 MB) cost more in page
+    // faults than filling it.
+    thread_local TwoNearest two;
+    findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided, two);
     for (size_t p = 0; p < N; ++p) {
         if (two.screen1[p] != kNoFragment) ++r.coveredPixels;
         if (two.screen2[p] != kNoFragment) ++r.twoSurfacePixels;

@@ -53,6 +53,9 @@ struct TwoNearest {
 // singleSided: as ZBufferSettings::singleSided (null: every triangle is drawn).
 TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic,
                           const uint8_t *singleSided = nullptr);
+// The same into `out`, its storage reused.
+void findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic, const uint8_t *singleSided,
+                    TwoNearest &out);
 
 // ---- Pixels that cannot fight, decided without encoding (zfight.cpp, 2a) ----------------------
 
