@@ -697,9 +697,16 @@ int eyeSide(const Scene &s, const Camera &cam, uint32_t q) {
 
 OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key) {
     const Stopwatch t0;
+    const std::vector<uint32_t> order = painterOrder(v, key);
+    OverlapTests r = painterOverlapTests(v, order);
+    r.ms = t0.ms();
+    return r;
+}
+
+OverlapTests painterOverlapTests(const OrderingView &v, const std::vector<uint32_t> &order) {
+    const Stopwatch t0;
     OverlapTests r;
     const Scene &scene = *v.scene;
-    const std::vector<uint32_t> order = painterOrder(v, key);
     std::vector<PairTri> tris;
     for (uint32_t rank = 0; rank < order.size(); ++rank) {
         const uint32_t s = order[rank];
@@ -797,8 +804,9 @@ namespace {
 
 // The painter's draw of its `drawn` triangles done (its stats; its ids in r.id): the counts, the
 // comparison with the reference and, when asked, the overlap tests.
-void finishPainter(const OrderingView &v, const ReferenceVisibility &ref, PainterKey key, bool overlapTests,
-                   size_t drawn, const DrawStats &st, PainterResult &r) {
+void finishPainter(const OrderingView &v, const ReferenceVisibility &ref, const std::vector<uint32_t> &order,
+                   bool overlapTests, const DrawStats &st, PainterResult &r) {
+    const size_t drawn = order.size();
     r.trianglesDrawn = drawn;
     r.drawMs = st.ms;
     r.fragments = st.fragments;
@@ -810,7 +818,12 @@ void finishPainter(const OrderingView &v, const ReferenceVisibility &ref, Painte
     r.edgePixels = c.edgePixels;
     r.cls = std::move(c.cls);
     r.memoryBytes = r.id.size() * sizeof(uint32_t) + drawn * (sizeof(double) + sizeof(uint32_t));
-    if (overlapTests) r.overlaps = painterOverlapTests(v, key);
+    if (overlapTests) {
+        // Its own time includes the sort it shares with the draw.
+        const double sortMs = r.sortMs;
+        r.overlaps = painterOverlapTests(v, order);
+        r.overlaps.ms += sortMs;
+    }
 }
 
 }  // namespace
@@ -825,7 +838,7 @@ PainterResult paintersAlgorithm(const OrderingView &v, const ReferenceVisibility
     std::vector<DrawItem> items(order.size());
     for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
     const DrawStats st = drawInOrder(v, items, false, nullptr, nullptr, &r.id);
-    finishPainter(v, ref, key, overlapTests, order.size(), st, r);
+    finishPainter(v, ref, order, overlapTests, st, r);
     return r;
 }
 
@@ -937,11 +950,13 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     std::vector<uint32_t> submittedIds;
     {
         std::vector<DrawItem> backToFront;
+        std::vector<uint32_t> painterSorted;
         if (v.fragments) {
             r.painter.key = settings.painterKey;
             const Stopwatch ts;
-            for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
+            painterSorted = painterOrder(v, settings.painterKey);
             r.painter.sortMs = ts.ms();
+            for (uint32_t s : painterSorted) backToFront.push_back({s});
         } else {
             r.painter = paintersAlgorithm(v, ref, settings.painterKey, settings.overlapTests);
             for (uint32_t s : painterOrder(v, settings.painterKey)) backToFront.push_back({s});
@@ -982,8 +997,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
             bspJobs(bspItemList, bspSel, r.bsp, jobs + 4);
             drawCached(v, jobs);
             for (int k = 0; k < 4; ++k) jobs[k].stats.ms += v.fragments->rasterMs;
-            finishPainter(v, ref, settings.painterKey, settings.overlapTests, backToFront.size(), jobs[0].stats,
-                          r.painter);
+            finishPainter(v, ref, painterSorted, settings.overlapTests, jobs[0].stats, r.painter);
             for (int k = 0; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k + 1].stats});
             bspTakeDraws(jobs + 4, bspSelectMs, r.bsp);
             bspCompare(v, ref, r.bsp);

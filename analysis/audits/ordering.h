@@ -104,6 +104,8 @@ struct OverlapTests {
     double ms = 0;
 };
 OverlapTests painterOverlapTests(const OrderingView &v, PainterKey key);
+// The same for the painter's order already sorted (painterOrder(v, key)); ms without the sort.
+OverlapTests painterOverlapTests(const OrderingView &v, const std::vector<uint32_t> &order);
 
 struct PainterResult {
     PainterKey key = PainterKey::centroid;
