@@ -59,13 +59,16 @@ struct ReferenceSink {
         return -area <= std::abs(e1x) + std::abs(e1y) + std::abs(e2x) + std::abs(e2y) + 4;
     }
     void fragment(size_t i, size_t, double d) {
-        if (cache && !overflow) {
+        if (cache) {
+            // Recorded only: the depth test runs afterwards from the cache, band by band
+            // (resolveFromCache). When the cache is full the walk runs again without it.
             if (cache->pixel.size() == cacheMax) {
                 overflow = true;
             } else {
                 cache->pixel.push_back(uint32_t(i));
                 cache->depth.push_back(d);
             }
+            return;
         }
         const double old = depth[i];
         if (d < old || (d == old && current < id[i])) {
@@ -78,6 +81,56 @@ struct ReferenceSink {
         if (cache) cache->begin[t + 1] = cache->pixel.size();
     }
 };
+
+// The reference's depth test (LESS on the double depth, ties to the lowest id) over the cached
+// fragments, 16 rows at a time: a triangle's fragments come in ascending pixel order (raster_core.h),
+// so each band's are a stretch of its range, and the band's slice of the depth and id buffers
+// (370 KB at 1080p) stays in the core's L2 instead of the walk's random access into 24 MB. The
+// rule does not depend on the order of the fragments, so the result is the walk's.
+void resolveFromCache(const FragmentCache &cache, const uint32_t *source, size_t width, size_t height, uint32_t *id,
+                      double *depth) {
+    constexpr size_t kBandRows = 16;
+    const size_t bandPixels = kBandRows * width, bands = width ? (height + kBandRows - 1) / kBandRows : 0;
+    const size_t tris = cache.begin.size() - 1;
+    if (bands == 0) return;
+    std::vector<uint32_t> bandBegin(bands + 1, 0), bandTris;
+    std::vector<uint64_t> at(tris);
+    for (size_t t = 0; t < tris; ++t) {
+        at[t] = cache.begin[t];
+        if (cache.begin[t + 1] == cache.begin[t]) continue;
+        const size_t b0 = cache.pixel[cache.begin[t]] / bandPixels, b1 = cache.pixel[cache.begin[t + 1] - 1] / bandPixels;
+        for (size_t b = b0; b <= b1; ++b) ++bandBegin[b + 1];
+    }
+    for (size_t b = 0; b < bands; ++b) bandBegin[b + 1] += bandBegin[b];
+    bandTris.resize(bandBegin[bands]);
+    {
+        std::vector<uint32_t> next(bandBegin.begin(), bandBegin.end() - 1);
+        for (size_t t = 0; t < tris; ++t) {
+            if (cache.begin[t + 1] == cache.begin[t]) continue;
+            const size_t b0 = cache.pixel[cache.begin[t]] / bandPixels, b1 = cache.pixel[cache.begin[t + 1] - 1] / bandPixels;
+            for (size_t b = b0; b <= b1; ++b) bandTris[next[b]++] = uint32_t(t);
+        }
+    }
+    const uint32_t *pixelOf = cache.pixel.data();
+    const double *depthOf = cache.depth.data();
+    for (size_t b = 0; b < bands; ++b) {
+        const uint32_t p1 = uint32_t(std::min((b + 1) * bandPixels, width * height));
+        for (uint32_t k = bandBegin[b]; k < bandBegin[b + 1]; ++k) {
+            const uint32_t t = bandTris[k], current = source[t] + 1;
+            const uint64_t end = cache.begin[t + 1];
+            uint64_t f = at[t];
+            for (; f < end && pixelOf[f] < p1; ++f) {
+                const uint32_t i = pixelOf[f];
+                const double d = depthOf[f], old = depth[i];
+                if (d < old || (d == old && current < id[i])) {
+                    depth[i] = d;
+                    id[i] = current;
+                }
+            }
+            at[t] = f;
+        }
+    }
+}
 
 // Unit roundoff of float (Embree's arithmetic) and pbrt's gamma(n) = n u / (1 - n u): a bound on
 // the relative error of n successive roundings.
@@ -173,11 +226,17 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
                        maxCachedFragments ? &cache : nullptr, maxCachedFragments};
     forEachFragment(screen, r.width, r.height, cam.orthographic, sink);
     if (sink.overflow) {
+        // More fragments than the cache holds: walk again with the depth test inline.
         cache = FragmentCache{};
+        ReferenceSink again{scene,        cam,           screen.xy.data(),       screen.source.data(),
+                            single.data(), r.id.data(),  r.depth.data(),         r.snappedFront.data(),
+                            nullptr,       0};
+        forEachFragment(screen, r.width, r.height, cam.orthographic, again);
     } else if (maxCachedFragments) {
         // Triangles the walk skipped (no endTriangle) hold no fragment: begin[t + 1] = begin[t].
         for (size_t t = 0; t < screen.size(); ++t) cache.begin[t + 1] = std::max(cache.begin[t + 1], cache.begin[t]);
         cache.rasterMs = tr.ms();
+        resolveFromCache(cache, screen.source.data(), size_t(r.width), size_t(r.height), r.id.data(), r.depth.data());
     }
     r.backWinding = sink.backWinding;
     r.fragments = sink.fragments;
