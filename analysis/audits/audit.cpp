@@ -83,53 +83,19 @@ struct ReferenceSink {
 };
 
 // The reference's depth test (LESS on the double depth, ties to the lowest id) over the cached
-// fragments, 16 rows at a time: a triangle's fragments come in ascending pixel order (raster_core.h),
-// so each band's are a stretch of its range, and the band's slice of the depth and id buffers
-// (370 KB at 1080p) stays in the core's L2 instead of the walk's random access into 24 MB. The
-// rule does not depend on the order of the fragments, so the result is the walk's.
+// fragments, band by band (forEachCachedFragmentByBand): the band's slice of the depth and id
+// buffers (370 KB at 1080p) stays in the core's L2 instead of the walk's random access into 24 MB.
+// The rule does not depend on the order of the fragments, so the result is the walk's.
 void resolveFromCache(const FragmentCache &cache, const uint32_t *source, size_t width, size_t height, uint32_t *id,
                       double *depth) {
-    constexpr size_t kBandRows = 16;
-    const size_t bandPixels = kBandRows * width, bands = width ? (height + kBandRows - 1) / kBandRows : 0;
-    const size_t tris = cache.begin.size() - 1;
-    if (bands == 0) return;
-    std::vector<uint32_t> bandBegin(bands + 1, 0), bandTris;
-    std::vector<uint64_t> at(tris);
-    for (size_t t = 0; t < tris; ++t) {
-        at[t] = cache.begin[t];
-        if (cache.begin[t + 1] == cache.begin[t]) continue;
-        const size_t b0 = cache.pixel[cache.begin[t]] / bandPixels, b1 = cache.pixel[cache.begin[t + 1] - 1] / bandPixels;
-        for (size_t b = b0; b <= b1; ++b) ++bandBegin[b + 1];
-    }
-    for (size_t b = 0; b < bands; ++b) bandBegin[b + 1] += bandBegin[b];
-    bandTris.resize(bandBegin[bands]);
-    {
-        std::vector<uint32_t> next(bandBegin.begin(), bandBegin.end() - 1);
-        for (size_t t = 0; t < tris; ++t) {
-            if (cache.begin[t + 1] == cache.begin[t]) continue;
-            const size_t b0 = cache.pixel[cache.begin[t]] / bandPixels, b1 = cache.pixel[cache.begin[t + 1] - 1] / bandPixels;
-            for (size_t b = b0; b <= b1; ++b) bandTris[next[b]++] = uint32_t(t);
+    forEachCachedFragmentByBand(cache, width, height, [&](uint32_t i, uint32_t t, double d) {
+        const uint32_t current = source[t] + 1;
+        const double old = depth[i];
+        if (d < old || (d == old && current < id[i])) {
+            depth[i] = d;
+            id[i] = current;
         }
-    }
-    const uint32_t *pixelOf = cache.pixel.data();
-    const double *depthOf = cache.depth.data();
-    for (size_t b = 0; b < bands; ++b) {
-        const uint32_t p1 = uint32_t(std::min((b + 1) * bandPixels, width * height));
-        for (uint32_t k = bandBegin[b]; k < bandBegin[b + 1]; ++k) {
-            const uint32_t t = bandTris[k], current = source[t] + 1;
-            const uint64_t end = cache.begin[t + 1];
-            uint64_t f = at[t];
-            for (; f < end && pixelOf[f] < p1; ++f) {
-                const uint32_t i = pixelOf[f];
-                const double d = depthOf[f], old = depth[i];
-                if (d < old || (d == old && current < id[i])) {
-                    depth[i] = d;
-                    id[i] = current;
-                }
-            }
-            at[t] = f;
-        }
-    }
+    });
 }
 
 // Unit roundoff of float (Embree's arithmetic) and pbrt's gamma(n) = n u / (1 - n u): a bound on

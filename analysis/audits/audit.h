@@ -4,8 +4,10 @@
 // calls them per view (docs/audits.md, "Integration").
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/scene.h"
@@ -40,6 +42,51 @@ struct FragmentCache {
     double rasterMs = 0;            // the rasterization that recorded them (walk + record)
     bool complete() const { return !begin.empty(); }
 };
+
+// Calls fn(pixel, t, d) for every fragment of a complete cache of a width x height view, 16 rows
+// at a time, and within a band triangle by triangle in ascending t: each pixel sees its fragments
+// in the walk's order, while a pass keeping per-pixel state touches one band's slice of it (in
+// L2) instead of the whole view's at random. A triangle's fragments come in ascending pixel order
+// (raster_core.h), so a band's are a stretch of its range, resumed in the next band.
+template <class Fn>
+void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_t height, Fn &&fn) {
+    constexpr size_t kBandRows = 16;
+    const size_t bandPixels = kBandRows * width, bands = width ? (height + kBandRows - 1) / kBandRows : 0;
+    if (bands == 0 || cache.begin.empty()) return;
+    const size_t tris = cache.begin.size() - 1;
+    std::vector<uint32_t> bandBegin(bands + 1, 0), bandTris;
+    std::vector<uint64_t> at(cache.begin.begin(), cache.begin.end() - 1);
+    auto bandsOf = [&](size_t t) {
+        return std::pair{size_t(cache.pixel[cache.begin[t]]) / bandPixels, size_t(cache.pixel[cache.begin[t + 1] - 1]) / bandPixels};
+    };
+    for (size_t t = 0; t < tris; ++t) {
+        if (cache.begin[t + 1] == cache.begin[t]) continue;
+        const auto [b0, b1] = bandsOf(t);
+        for (size_t b = b0; b <= b1; ++b) ++bandBegin[b + 1];
+    }
+    for (size_t b = 0; b < bands; ++b) bandBegin[b + 1] += bandBegin[b];
+    bandTris.resize(bandBegin[bands]);
+    {
+        std::vector<uint32_t> next(bandBegin.begin(), bandBegin.end() - 1);
+        for (size_t t = 0; t < tris; ++t) {
+            if (cache.begin[t + 1] == cache.begin[t]) continue;
+            const auto [b0, b1] = bandsOf(t);
+            for (size_t b = b0; b <= b1; ++b) bandTris[next[b]++] = uint32_t(t);
+        }
+    }
+    const uint32_t *pixelOf = cache.pixel.data();
+    const double *depthOf = cache.depth.data();
+    for (size_t b = 0; b < bands; ++b) {
+        const uint32_t p1 = uint32_t(std::min((b + 1) * bandPixels, width * height));
+        for (uint32_t k = bandBegin[b]; k < bandBegin[b + 1]; ++k) {
+            const uint32_t t = bandTris[k];
+            const uint64_t end = cache.begin[t + 1];
+            uint64_t f = at[t];
+            for (; f < end && pixelOf[f] < p1; ++f) fn(pixelOf[f], t, depthOf[f]);
+            at[t] = f;
+        }
+    }
+}
 
 struct ReferenceVisibility {
     int width = 0, height = 0;
