@@ -535,6 +535,9 @@ void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &
     const size_t N = two.pixels(), F = settings.formats.size();
     std::vector<uint32_t> pixel;
     std::vector<double> near1, near2;
+    pixel.reserve(r.twoSurfacePixels);  // counted by the caller: no regrowth
+    near1.reserve(r.twoSurfacePixels);
+    near2.reserve(r.twoSurfacePixels);
     double oneMin = kInf, oneMax = -kInf;
     bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
     double twoMin = kInf, twoMax = 0;  // finite positive depths of the two-surface pixels
