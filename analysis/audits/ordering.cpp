@@ -412,7 +412,7 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
 // pixel counts as covered when its first fragment passes (from +inf every finite depth passes);
 // the id buffer is kept only when the caller wants it. Without the depth test every fragment
 // writes, and the ids count the covered pixels.
-constexpr size_t kBandRows = 16;
+constexpr size_t kBandRows = kFragmentBandRows;
 
 struct DrawJob {
     const std::vector<DrawItem> *items = nullptr;
@@ -473,14 +473,8 @@ struct BandedDraw {
                                fc.pixel[fc.begin[t + 1] - 1]);
             }
         }
-        bandBegin.assign(bands + 1, 0);
-        for (size_t r = 0; r < runs.size(); ++r)
-            for (uint32_t b = firstBand[r]; b <= runs[r].lastBand; ++b) ++bandBegin[b + 1];
-        for (size_t b = 0; b < bands; ++b) bandBegin[b + 1] += bandBegin[b];
-        bandRuns.resize(bandBegin[bands]);
-        std::vector<uint32_t> next(bandBegin.begin(), bandBegin.end() - 1);
-        for (size_t r = 0; r < runs.size(); ++r)
-            for (uint32_t b = firstBand[r]; b <= runs[r].lastBand; ++b) bandRuns[next[b]++] = uint32_t(r);
+        bandLists(runs.size(), bands, [&](size_t r) { return std::pair<size_t, size_t>{firstBand[r], runs[r].lastBand}; },
+                  bandBegin, bandRuns);
         if (job.depthTest) depth.resize(bandPixels);
         id.clear();
         if (!job.depthTest || job.idsOut) id.resize(pixels, 0);
