@@ -102,6 +102,41 @@ void appendPngBytes(png_structp png, png_bytep data, png_size_t n) {
 }
 void flushNothing(png_structp) {}
 
+// zlib's stream at level 1 with a 32 KB window built from its parts: the two header bytes
+// deflateInit2 writes for it, raw deflate from a stream kept per thread (reset, not set up again,
+// per call: the same bytes as compress2's or as a fresh stream's), and the Adler-32 trailer from
+// libdeflate (SIMD: zlib 1.2's scalar one took a fifth of an EXR chunk's time). The strategy is
+// zlib's (the EXR chunks use the default, PNGs libpng's run-length one). compress() returns the
+// stream's size, or 0 when it does not fit in `out` or zlib fails.
+class ZlibLevel1 {
+  public:
+    explicit ZlibLevel1(int strategy) { ok_ = deflateInit2(&z_, 1, Z_DEFLATED, -15, 8, strategy) == Z_OK; }
+    ~ZlibLevel1() {
+        if (ok_) deflateEnd(&z_);
+    }
+    ZlibLevel1(const ZlibLevel1 &) = delete;
+    ZlibLevel1 &operator=(const ZlibLevel1 &) = delete;
+
+    size_t compress(const uint8_t *in, size_t n, uint8_t *out, size_t capacity) {
+        if (!ok_ || capacity < 6 || n > UINT32_MAX || deflateReset(&z_) != Z_OK) return 0;
+        out[0] = 0x78;  // CMF: deflate, 32 KB window
+        out[1] = 0x01;  // FLG: level 1's "fastest" level bits, FCHECK making the pair a multiple of 31
+        z_.next_in = const_cast<uint8_t *>(in);
+        z_.avail_in = uInt(n);
+        z_.next_out = out + 2;
+        z_.avail_out = uInt(std::min<size_t>(capacity - 6, UINT32_MAX));
+        if (deflate(&z_, Z_FINISH) != Z_STREAM_END) return 0;
+        const size_t size = 2 + size_t(z_.total_out);
+        const uint32_t adler = libdeflate_adler32(1, in, n);
+        for (int i = 0; i < 4; ++i) out[size + size_t(i)] = uint8_t(adler >> (24 - 8 * i));  // big-endian
+        return size + 4;
+    }
+
+  private:
+    z_stream z_{};
+    bool ok_ = false;
+};
+
 // The image data of a PNG of more than kPngSmallImage filtered bytes written as libpng 1.6 would
 // write it, at half its time: libpng filters, deflates and checksums row by row (filter, Adler-32
 // and CRC each a scalar byte loop), while here the "up" filter runs over the whole image in
@@ -130,24 +165,13 @@ bool writeIdatDirect(png_structp png, int height, size_t rowBytes, const uint8_t
             for (size_t x = 0; x < rowBytes; ++x) d[1 + x] = uint8_t(c[x] - u[x]);
         }
     }
-    z_stream zs{};
-    if (deflateInit2(&zs, 1, Z_DEFLATED, -15, 8, Z_RLE) != Z_OK) return false;
-    z.resize(deflateBound(&zs, uLong(filtered.size())) + 6);
-    z[0] = 0x78;  // as deflateInit2 with a 32 KB window at level 1 writes them
-    z[1] = 0x01;
-    zs.next_in = filtered.data();
-    zs.avail_in = uInt(filtered.size());
-    zs.next_out = z.data() + 2;
-    zs.avail_out = uInt(z.size() - 6);
-    const bool ok = deflate(&zs, Z_FINISH) == Z_STREAM_END;
-    const size_t size = 2 + size_t(zs.total_out);
-    deflateEnd(&zs);
-    if (!ok) return false;
-    const uint32_t adler = libdeflate_adler32(1, filtered.data(), filtered.size());
-    for (int i = 0; i < 4; ++i) z[size + size_t(i)] = uint8_t(adler >> (24 - 8 * i));
+    thread_local ZlibLevel1 zlib(Z_RLE);
+    z.resize(compressBound(uLong(filtered.size())));
+    const size_t size = zlib.compress(filtered.data(), filtered.size(), z.data(), z.size());
+    if (size == 0) return false;
     static const png_byte idat[5] = "IDAT", iend[5] = "IEND";
-    for (size_t at = 0; at < size + 4; at += kPngIdatChunk)
-        png_write_chunk(png, idat, z.data() + at, std::min(kPngIdatChunk, size + 4 - at));
+    for (size_t at = 0; at < size; at += kPngIdatChunk)
+        png_write_chunk(png, idat, z.data() + at, std::min(kPngIdatChunk, size - at));
     png_write_chunk(png, iend, nullptr, 0);
     return true;
 }
@@ -244,39 +268,6 @@ int64_t exrWrite(exr_const_context_t, void *user, const void *buffer, uint64_t s
     return int64_t(size);
 }
 
-// zlib's stream at level 1 built from its parts: the two header bytes deflateInit writes at level 1
-// with a 32 KB window, raw deflate from a stream kept per thread (reset, not set up again, per
-// chunk: the bytes are the same as compress2's), and the Adler-32 trailer computed by libdeflate
-// (SIMD: zlib 1.2's scalar one took a fifth of a chunk's time). Returns the size, or 0 when the
-// chunk does not fit in `out` or zlib fails.
-class ZlibLevel1 {
-  public:
-    ZlibLevel1() { ok_ = deflateInit2(&z_, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) == Z_OK; }
-    ~ZlibLevel1() {
-        if (ok_) deflateEnd(&z_);
-    }
-    ZlibLevel1(const ZlibLevel1 &) = delete;
-    ZlibLevel1 &operator=(const ZlibLevel1 &) = delete;
-
-    size_t compress(const uint8_t *in, size_t n, uint8_t *out, size_t capacity) {
-        if (!ok_ || capacity < 6 || n > UINT32_MAX || deflateReset(&z_) != Z_OK) return 0;
-        out[0] = 0x78;  // CMF: deflate, 32 KB window
-        out[1] = 0x01;  // FLG: level 1's "fastest" level bits, FCHECK making the pair a multiple of 31
-        z_.next_in = const_cast<uint8_t *>(in);
-        z_.avail_in = uInt(n);
-        z_.next_out = out + 2;
-        z_.avail_out = uInt(std::min<size_t>(capacity - 6, UINT32_MAX));
-        if (deflate(&z_, Z_FINISH) != Z_STREAM_END) return 0;
-        const size_t size = 2 + size_t(z_.total_out);
-        const uint32_t adler = libdeflate_adler32(1, in, n);
-        for (int i = 0; i < 4; ++i) out[size + size_t(i)] = uint8_t(adler >> (24 - 8 * i));  // big-endian
-        return size + 4;
-    }
-
-  private:
-    z_stream z_{};
-    bool ok_ = false;
-};
 
 // The ZIP filter and zlib on `n` bytes; the compressed size, or 0 when zlib fails.
 size_t zipChunk(const uint8_t *raw, size_t n, std::vector<uint8_t> &split, std::vector<uint8_t> &filtered,
@@ -296,7 +287,7 @@ size_t zipChunk(const uint8_t *raw, size_t n, std::vector<uint8_t> &split, std::
     if (n) d[0] = t[0];
     for (size_t i = 1; i < n; ++i) d[i] = uint8_t(t[i] - t[i - 1] + 128);
     out.resize(compressBound(uLong(n)));
-    thread_local ZlibLevel1 zlib;
+    thread_local ZlibLevel1 zlib(Z_DEFAULT_STRATEGY);
     return zlib.compress(filtered.data(), n, out.data(), out.size());
 }
 
