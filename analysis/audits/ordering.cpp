@@ -485,15 +485,15 @@ struct BandedDraw {
         const uint32_t *pixelOf = fc.pixel.data();
         const double *depthOf = fc.depth.data();
         uint32_t *ids = id.data();
-        double *z = depth.data() - p0;  // indexed by the whole screen's pixel
+        double *z = depth.data();  // the band's: pixel - p0
         if constexpr (kDepthTest) std::fill(depth.begin(), depth.end(), std::numeric_limits<double>::infinity());
         uint64_t n = 0, pass = 0, cover = 0;
         auto write = [&](uint32_t pixel, double d, uint32_t current) {
             if constexpr (!kDepthTest) {
                 ids[pixel] = current;
-            } else if (d < z[pixel]) {
-                cover += z[pixel] == std::numeric_limits<double>::infinity();
-                z[pixel] = d;
+            } else if (double &old = z[pixel - p0]; d < old) {
+                cover += old == std::numeric_limits<double>::infinity();
+                old = d;
                 if (keepIds) ids[pixel] = current;
                 ++pass;
             }
