@@ -361,7 +361,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // The reference's screen triangles and fragments served the ordering audit only: a finished
     // view keeps neither (estimateMemory's finishedViews).
     if (r.audit.ran()) {
-        r.audit->reference.fragmentCache = FragmentCache{};
+        recycleFragmentCache(r.audit->reference.fragmentCache);  // its storage, for the next view
         r.audit->reference.screen = ScreenTriangles{};
     }
     // Detail: triangles drawn against the pixels they show, too small, over-detailed.

@@ -303,6 +303,22 @@ void checkScene(const Scene &s, const std::vector<ViewSpec> &views, const std::s
             EXPECT_EQ(v->backWinding, ref.backWinding);
             EXPECT_EQ(v->snappedFront, ref.snappedFront);
         }
+        // A cache given back (recycleFragmentCache, as the pipeline does when a view is done) is
+        // the next view's storage: the same memory, emptied, and the same fragments recorded.
+        {
+            ReferenceVisibility first = referenceVisibility(s, cam, uint64_t(1) << 30);
+            const uint32_t *storage = first.fragmentCache.pixel.data();
+            recycleFragmentCache(first.fragmentCache);
+            EXPECT_FALSE(first.fragmentCache.complete());
+            EXPECT_EQ(first.fragmentCache.pixel.capacity(), 0u);
+            const ReferenceVisibility again = referenceVisibility(s, cam, uint64_t(1) << 30);
+            EXPECT_EQ(again.fragmentCache.pixel.data(), storage);
+            EXPECT_EQ(again.fragmentCache.begin, cached.fragmentCache.begin);
+            EXPECT_EQ(again.fragmentCache.pixel, cached.fragmentCache.pixel);
+            EXPECT_EQ(again.fragmentCache.depth, cached.fragmentCache.depth);
+            EXPECT_EQ(again.id, ref.id);
+            EXPECT_EQ(again.depth, ref.depth);
+        }
         const OrderingResult c = analyzeOrdering(s, cam, cached, tree, plan.abuffer);
         auto same = [&](const DrawStats &a, const DrawStats &b, const std::string &name) {
             EXPECT_EQ(a.fragments, b.fragments) << name;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <mutex>
 #include <unordered_map>
 
 #include "analysis/stages/backface.h"
@@ -156,6 +157,42 @@ std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
     return s;
 }
 
+namespace {
+
+// The fragment caches given back (recycleFragmentCache), for the next views to record into.
+struct FragmentCacheStore {
+    std::mutex mutex;
+    std::vector<FragmentCache> caches;
+};
+FragmentCacheStore &fragmentCacheStore() {
+    static FragmentCacheStore store;
+    return store;
+}
+
+FragmentCache takeFragmentCache() {
+    FragmentCacheStore &store = fragmentCacheStore();
+    const std::lock_guard<std::mutex> lock(store.mutex);
+    if (store.caches.empty()) return {};
+    FragmentCache c = std::move(store.caches.back());
+    store.caches.pop_back();
+    return c;
+}
+
+}  // namespace
+
+void recycleFragmentCache(FragmentCache &c) {
+    FragmentCache kept = std::move(c);
+    c = FragmentCache{};
+    if (kept.pixel.capacity() == 0 && kept.depth.capacity() == 0) return;
+    kept.begin.clear();
+    kept.pixel.clear();
+    kept.depth.clear();
+    kept.rasterMs = 0;
+    FragmentCacheStore &store = fragmentCacheStore();
+    const std::lock_guard<std::mutex> lock(store.mutex);
+    store.caches.push_back(std::move(kept));
+}
+
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments) {
     const Stopwatch t0;
     ReferenceVisibility r;
@@ -181,6 +218,7 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
     r.snappedFront.assign(scene.triangleCount(), 0);
     FragmentCache &cache = r.fragmentCache;
     if (maxCachedFragments) {
+        cache = takeFragmentCache();  // a previous view's storage, when one was given back
         cache.begin.assign(screen.size() + 1, 0);
         // Reserved whole, so it never reallocates (pages are touched only as fragments arrive).
         cache.pixel.reserve(maxCachedFragments);
@@ -193,7 +231,7 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
     forEachFragment(screen, r.width, r.height, cam.orthographic, sink);
     if (sink.overflow) {
         // More fragments than the cache holds: walk again with the depth test inline.
-        cache = FragmentCache{};
+        recycleFragmentCache(cache);
         ReferenceSink again{scene,        cam,           screen.xy.data(),       screen.source.data(),
                             single.data(), r.id.data(),  r.depth.data(),         r.snappedFront.data(),
                             nullptr,       0};
