@@ -349,7 +349,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     for (const ObjectStage *stage : kObjectStages) runObjectStage(c, *stage, objects);
     if (c.stopped()) return r;
     const TriangleLists lists = runBackface(c, objects);
-    const ClipResult clip = runClip(c, lists);
+    ClipResult clip = runClip(c, lists);
     if (c.stopped()) return r;
     std::vector<uint32_t> fragmentsPerSource = runZBuffer(c, clip);
     if (c.stopped()) return r;
@@ -361,8 +361,8 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     // The reference's screen triangles and fragments served the ordering audit only: a finished
     // view keeps neither (estimateMemory's finishedViews).
     if (r.audit.ran()) {
-        recycleFragmentCache(r.audit->reference.fragmentCache);  // its storage, for the next view
-        r.audit->reference.screen = ScreenTriangles{};
+        recycleFragmentCache(r.audit->reference.fragmentCache);  // their storage, for the next view
+        recycleScreenTriangles(r.audit->reference.screen);
     }
     // Detail: triangles drawn against the pixels they show, too small, over-detailed.
     if (c.stopped()) return r;
@@ -370,6 +370,7 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     else r.detail.skip("turned off by --no-detail");
     if (c.stopped()) return r;
     runZFightAudit(c, clip);
+    recycleScreenTriangles(clip.out);  // for the next view's clip
     r.totalMs = tView.ms();
     return r;
 }

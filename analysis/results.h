@@ -152,7 +152,7 @@ struct ViewResult {
     // Frees every per-pixel buffer once the images are written; what the report reads (the
     // statistics, hotspot and offender lists) stays. Each result frees its own buffers.
     void releasePixelBuffers() {
-        buffer = ZBuffer{};
+        recycleZBuffer(buffer);  // for a later view's z-buffer
         if (raycast.ran()) raycast->releasePixels();
         if (effects.ran()) effects->releasePixels();
         if (audit.ran()) audit->releasePixels();

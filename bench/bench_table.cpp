@@ -332,6 +332,7 @@ ZbufferFigures runZbuffer(const Options &o, const Scene &scene, const Camera &ca
         tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
         std::vector<double> t;
         for (int r = 0; r < std::max(1, o.reps / 2); ++r) {
+            recycleScreenTriangles(clip.out);  // the previous repetition's, as a finished view's
             const double c0 = threadCpu();
             clip = clipLists(scene, cam, all);
             t.push_back(threadCpu() - c0);
@@ -349,16 +350,20 @@ ZbufferFigures runZbuffer(const Options &o, const Scene &scene, const Camera &ca
         auto now = [&] { return threads ? threadCpu() : wallNow(); };
         std::vector<double> plain, culled;
         for (int r = 0; r < o.reps; ++r) {
+            // Each buffer given back after its repetition, as a finished view's (render/recycle.h;
+            // llvmpipe's framebuffer, too, is made once and drawn into again).
             double t0 = now();
-            const ZBufferResult res = rasterize(clip.out, cam.width, cam.height, zs);
+            ZBufferResult res = rasterize(clip.out, cam.width, cam.height, zs);
             plain.push_back(now() - t0);
             z.fragments = res.stats.fragments;
             z.depthPasses = res.stats.depthPasses;
+            recycleZBuffer(res.buffer);
             t0 = now();
             const BackfaceResult b = cullBackfaces(scene, objects, cam);
-            const ZBufferResult rc = rasterize(keptClip.out, cam.width, cam.height, zs);
+            ZBufferResult rc = rasterize(keptClip.out, cam.width, cam.height, zs);
             culled.push_back(now() - t0);
             z.fragmentsCulled = rc.stats.fragments;
+            recycleZBuffer(rc.buffer);
             if (b.kept.size() != z.kept) std::abort();
         }
         (threads ? z.oneS : z.allS) = best(plain);
@@ -388,14 +393,17 @@ PipelineFigures runPipeline(const Options &o, const Scene &scene, const Camera &
         const double c1 = threadCpu();
         const BackfaceResult bf = cullBackfaces(scene, fr.visible, cam);
         const double c2 = threadCpu();
-        const ClipResult clip = clipLists(scene, cam, bf.kept);
+        ClipResult clip = clipLists(scene, cam, bf.kept);
         const double c3 = threadCpu();
-        const ZBufferResult z = rasterize(clip.out, cam.width, cam.height, zs);
+        ZBufferResult z = rasterize(clip.out, cam.width, cam.height, zs);
         const double c4 = threadCpu();
         tf.push_back(c1 - c0), tb.push_back(c2 - c1), tc.push_back(c3 - c2), tz.push_back(c4 - c3), tt.push_back(c4 - c0);
         f.objects = scene.objects.size(), f.visibleObjects = fr.visible.size(), f.kept = bf.kept.size();
         f.screenTriangles = clip.out.size();
-        (void)z;
+        // Given back as analyzeView gives a finished view's (render/recycle.h): the next repetition
+        // is the next view, filling the same memory.
+        recycleScreenTriangles(clip.out);
+        recycleZBuffer(z.buffer);
     }
     f.frustumS = best(tf), f.backfaceS = best(tb), f.clipS = best(tc), f.zbufferS = best(tz), f.totalS = best(tt);
     return f;

@@ -197,6 +197,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     ClipResult r;
     ClipStats &st = r.stats;
     ScreenTriangles &out = r.out;
+    out = takeRecycledScreenTriangles();  // a finished view's storage, when one gave it back
 
     const ClipSpace cs = clipSpaceOf(cam, settings);
     const DepthPlaneMaker planeOf(cam);

@@ -21,6 +21,7 @@
 #include "render/large_pages.h"
 #include "render/raster_core.h"
 #include "render/raster_kernel.h"
+#include "render/recycle.h"
 
 namespace va {
 
@@ -169,6 +170,38 @@ ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth)
 WalkFn walkFunctionBase(DepthFormat format, bool exactDepth) { return selectWalk<false>(format, exactDepth); }
 }  // namespace raster_detail
 
+namespace {
+Recycler<ZBuffer> &zbufferRecycler() {
+    static Recycler<ZBuffer> r;
+    return r;
+}
+Recycler<ScreenTriangles> &screenRecycler() {
+    static Recycler<ScreenTriangles> r;
+    return r;
+}
+}  // namespace
+
+void recycleZBuffer(ZBuffer &zb) {
+    ZBuffer kept = std::move(zb);
+    zb = ZBuffer{};
+    if (kept.key.capacity() + kept.id.capacity() + kept.depth.capacity() + kept.fragments.capacity() +
+            kept.passes.capacity() == 0)
+        return;
+    kept.width = kept.height = 0;
+    kept.key.clear(), kept.id.clear(), kept.depth.clear(), kept.fragments.clear(), kept.passes.clear();
+    zbufferRecycler().give(std::move(kept));
+}
+
+void recycleScreenTriangles(ScreenTriangles &tris) {
+    ScreenTriangles kept = std::move(tris);
+    tris = ScreenTriangles{};
+    if (kept.xy.capacity() == 0 && kept.planes.capacity() == 0) return;
+    kept.clear();
+    screenRecycler().give(std::move(kept));
+}
+
+ScreenTriangles takeRecycledScreenTriangles() { return screenRecycler().take(); }
+
 ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings) {
     return rasterize(tris, width, height, settings, RasterStrategy{});
 }
@@ -177,6 +210,7 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
                         const RasterStrategy &strategy) {
     ZBufferResult r;
     ZBuffer &zb = r.buffer;
+    zb = zbufferRecycler().take();  // a finished view's buffers, when one gave them back
     zb.width = std::max(width, 0);
     zb.height = std::max(height, 0);
     const size_t pixels = size_t(zb.width) * size_t(zb.height);

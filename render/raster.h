@@ -129,4 +129,12 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
 // Fills the stats that follow from the per-pixel counts (covered pixels, ratios, histogram).
 void finishZBufferStats(const ZBuffer &zb, ZBufferStats *stats);
 
+// Storage handed to the next view (render/recycle.h): a finished view gives its z-buffer's
+// per-pixel buffers and its screen triangles back, and the next rasterize() and clipTriangles()
+// fill them instead of faulting fresh pages in. Each leaves its argument empty.
+void recycleZBuffer(ZBuffer &zb);
+void recycleScreenTriangles(ScreenTriangles &tris);
+// Storage given back, emptied (a fresh ScreenTriangles when there is none): clipTriangles' output.
+ScreenTriangles takeRecycledScreenTriangles();
+
 }  // namespace va

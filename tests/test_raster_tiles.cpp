@@ -214,5 +214,51 @@ TEST(RasterTiles, BenchSceneMatchesPlainWalk) {
                     "bench scene, tiled, 2 threads");
 }
 
+// Storage given back (recycleZBuffer, recycleScreenTriangles: a finished view's) is what the next
+// rasterize() and clipTriangles() fill: the same memory, and the same results as fresh storage,
+// also when the previous use was larger (stale contents must not show) or of another size.
+TEST(RasterTiles, RecycledStorageGivesTheSameResults) {
+    const int W = 203, H = 117;
+    ZBufferSettings s;
+    s.encoder = makeDepthEncoder(DepthFormat::unorm24, 0.5, 200);
+    const ScreenTriangles small = tileSoup(5, W, H, 200, false), large = tileSoup(6, 2 * W, 2 * H, 900, false);
+    const ZBufferResult wantSmall = rasterizeOn(1, small, W, H, s, {});
+    ZBufferResult big = rasterizeOn(1, large, 2 * W, 2 * H, s, {});
+    const uint32_t *idStorage = big.buffer.id.data();
+    recycleZBuffer(big.buffer);
+    EXPECT_EQ(big.buffer.id.capacity(), 0u);
+    EXPECT_EQ(big.buffer.width, 0);
+    const ZBufferResult again = rasterizeOn(1, small, W, H, s, {});
+    EXPECT_EQ(again.buffer.id.data(), idStorage);
+    expectIdentical(again, wantSmall, "recycled z-buffer");
+
+    const RawMesh mesh = sphereGridMesh();
+    Camera cam;
+    std::string err;
+    ASSERT_TRUE(makeCamera(benchmarkCamera(), &cam, &err)) << err;
+    std::vector<uint32_t> order(mesh.indices.size() / 3);
+    for (uint32_t t = 0; t < order.size(); ++t) order[t] = t;
+    const ClipBatch all{0, uint32_t(mesh.positions.size()), order.data(), uint32_t(order.size())};
+    const ClipBatch half{0, uint32_t(mesh.positions.size()), order.data(), uint32_t(order.size() / 2)};
+    const MeshView view{mesh.positions.data(), mesh.indices.data()};
+    const ClipResult wantHalf = clipTriangles(cam, view, {half}, {});
+    ClipResult first = clipTriangles(cam, view, {all}, {});
+    const int32_t *xyStorage = first.out.xy.data();
+    recycleScreenTriangles(first.out);
+    EXPECT_EQ(first.out.size(), 0u);
+    const ClipResult second = clipTriangles(cam, view, {half}, {});
+    EXPECT_EQ(second.out.xy.data(), xyStorage);
+    EXPECT_EQ(second.out.xy, wantHalf.out.xy);
+    EXPECT_EQ(second.out.source, wantHalf.out.source);
+    EXPECT_EQ(second.out.plane, wantHalf.out.plane);
+    ASSERT_EQ(second.out.planes.size(), wantHalf.out.planes.size());
+    for (size_t k = 0; k < wantHalf.out.planes.size(); ++k) {
+        const DepthPlane &a = second.out.planes[k], &b = wantHalf.out.planes[k];
+        ASSERT_TRUE(std::memcmp(&a.a, &b.a, sizeof(double)) == 0 && std::memcmp(&a.b, &b.b, sizeof(double)) == 0 &&
+                    std::memcmp(&a.c, &b.c, sizeof(double)) == 0 && a.valid == b.valid)
+            << "plane " << k;
+    }
+}
+
 }  // namespace
 }  // namespace va

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
-#include <mutex>
 #include <unordered_map>
 
 #include "analysis/stages/backface.h"
 #include "render/raster.h"
 #include "render/raster_core.h"
+#include "render/recycle.h"
 #include "render/stopwatch.h"
 
 namespace va {
@@ -158,26 +158,10 @@ std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
 }
 
 namespace {
-
-// The fragment caches given back (recycleFragmentCache), for the next views to record into.
-struct FragmentCacheStore {
-    std::mutex mutex;
-    std::vector<FragmentCache> caches;
-};
-FragmentCacheStore &fragmentCacheStore() {
-    static FragmentCacheStore store;
-    return store;
+Recycler<FragmentCache> &fragmentCacheRecycler() {
+    static Recycler<FragmentCache> r;
+    return r;
 }
-
-FragmentCache takeFragmentCache() {
-    FragmentCacheStore &store = fragmentCacheStore();
-    const std::lock_guard<std::mutex> lock(store.mutex);
-    if (store.caches.empty()) return {};
-    FragmentCache c = std::move(store.caches.back());
-    store.caches.pop_back();
-    return c;
-}
-
 }  // namespace
 
 void recycleFragmentCache(FragmentCache &c) {
@@ -188,9 +172,7 @@ void recycleFragmentCache(FragmentCache &c) {
     kept.pixel.clear();
     kept.depth.clear();
     kept.rasterMs = 0;
-    FragmentCacheStore &store = fragmentCacheStore();
-    const std::lock_guard<std::mutex> lock(store.mutex);
-    store.caches.push_back(std::move(kept));
+    fragmentCacheRecycler().give(std::move(kept));
 }
 
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments) {
@@ -218,7 +200,7 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
     r.snappedFront.assign(scene.triangleCount(), 0);
     FragmentCache &cache = r.fragmentCache;
     if (maxCachedFragments) {
-        cache = takeFragmentCache();  // a previous view's storage, when one was given back
+        cache = fragmentCacheRecycler().take();  // a previous view's storage, when one was given back
         cache.begin.assign(screen.size() + 1, 0);
         // Reserved whole, so it never reallocates (pages are touched only as fragments arrive).
         cache.pixel.reserve(maxCachedFragments);

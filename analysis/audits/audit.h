@@ -120,10 +120,9 @@ struct ReferenceVisibility {
 // `maxCachedFragments` > 0 keeps every fragment in `fragments` as long as there are at most that
 // many (12 bytes each); more, and fragmentCache stays empty (its users rasterize again: same results).
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments = 0);
-// Gives a fragment cache's storage back for the next referenceVisibility to record into (emptied,
-// its pages kept): a 1080p view's cache is ~100 MB, and faulting fresh pages in for every view
-// cost the walk as much as recording into them. The store holds at most as many caches as were
-// ever in use at once (one per view in flight); `c` is left empty.
+// Gives a fragment cache's storage back for the next referenceVisibility to record into
+// (render/recycle.h): a 1080p view's cache is ~100 MB, and faulting fresh pages in for every view
+// cost the walk as much as recording into them. `c` is left empty.
 void recycleFragmentCache(FragmentCache &c);
 
 // ---- False culls and wasted draws ---------------------------------------------------------------
