@@ -170,17 +170,6 @@ ShadeFn shadeFunctionBase(DepthFormat format, bool perspective, bool exactDepth)
 WalkFn walkFunctionBase(DepthFormat format, bool exactDepth) { return selectWalk<false>(format, exactDepth); }
 }  // namespace raster_detail
 
-namespace {
-Recycler<ZBuffer> &zbufferRecycler() {
-    static Recycler<ZBuffer> r;
-    return r;
-}
-Recycler<ScreenTriangles> &screenRecycler() {
-    static Recycler<ScreenTriangles> r;
-    return r;
-}
-}  // namespace
-
 void recycleZBuffer(ZBuffer &zb) {
     ZBuffer kept = std::move(zb);
     zb = ZBuffer{};
@@ -189,7 +178,7 @@ void recycleZBuffer(ZBuffer &zb) {
         return;
     kept.width = kept.height = 0;
     kept.key.clear(), kept.id.clear(), kept.depth.clear(), kept.fragments.clear(), kept.passes.clear();
-    zbufferRecycler().give(std::move(kept));
+    recyclerOf<ZBuffer>().give(std::move(kept));
 }
 
 void recycleScreenTriangles(ScreenTriangles &tris) {
@@ -197,10 +186,10 @@ void recycleScreenTriangles(ScreenTriangles &tris) {
     tris = ScreenTriangles{};
     if (kept.xy.capacity() == 0 && kept.planes.capacity() == 0) return;
     kept.clear();
-    screenRecycler().give(std::move(kept));
+    recyclerOf<ScreenTriangles>().give(std::move(kept));
 }
 
-ScreenTriangles takeRecycledScreenTriangles() { return screenRecycler().take(); }
+ScreenTriangles takeRecycledScreenTriangles() { return recyclerOf<ScreenTriangles>().take(); }
 
 ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, const ZBufferSettings &settings) {
     return rasterize(tris, width, height, settings, RasterStrategy{});
@@ -210,7 +199,7 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
                         const RasterStrategy &strategy) {
     ZBufferResult r;
     ZBuffer &zb = r.buffer;
-    zb = zbufferRecycler().take();  // a finished view's buffers, when one gave them back
+    zb = recyclerOf<ZBuffer>().take();  // a finished view's buffers, when one gave them back
     zb.width = std::max(width, 0);
     zb.height = std::max(height, 0);
     const size_t pixels = size_t(zb.width) * size_t(zb.height);

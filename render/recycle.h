@@ -35,4 +35,12 @@ class Recycler {
     std::vector<T> kept_;
 };
 
+// The process's one Recycler of T, never destroyed: a view still running while the process exits
+// may give its storage back after static destructors have run.
+template <class T>
+Recycler<T> &recyclerOf() {
+    static Recycler<T> &r = *new Recycler<T>;
+    return r;
+}
+
 }  // namespace va

@@ -157,13 +157,6 @@ std::vector<uint8_t> singleSidedTriangles(const Scene &scene) {
     return s;
 }
 
-namespace {
-Recycler<FragmentCache> &fragmentCacheRecycler() {
-    static Recycler<FragmentCache> r;
-    return r;
-}
-}  // namespace
-
 void recycleFragmentCache(FragmentCache &c) {
     FragmentCache kept = std::move(c);
     c = FragmentCache{};
@@ -172,7 +165,7 @@ void recycleFragmentCache(FragmentCache &c) {
     kept.pixel.clear();
     kept.depth.clear();
     kept.rasterMs = 0;
-    fragmentCacheRecycler().give(std::move(kept));
+    recyclerOf<FragmentCache>().give(std::move(kept));
 }
 
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments) {
@@ -200,7 +193,7 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
     r.snappedFront.assign(scene.triangleCount(), 0);
     FragmentCache &cache = r.fragmentCache;
     if (maxCachedFragments) {
-        cache = fragmentCacheRecycler().take();  // a previous view's storage, when one was given back
+        cache = recyclerOf<FragmentCache>().take();  // a previous view's storage, when one was given back
         cache.begin.assign(screen.size() + 1, 0);
         // Reserved whole, so it never reallocates (pages are touched only as fragments arrive).
         cache.pixel.reserve(maxCachedFragments);
