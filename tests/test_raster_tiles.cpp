@@ -194,16 +194,26 @@ TEST(RasterTiles, OptionsMatchPlainWalk) {
         }
 }
 
-// The benchmark scene (1,000,002 triangles): the default strategy on 2 threads against the plain walk.
-TEST(RasterTiles, BenchSceneMatchesPlainWalk) {
-    const RawMesh mesh = sphereGridMesh();
+// The benchmark scene (1,000,002 triangles), its camera and every triangle in order.
+struct BenchInput {
+    RawMesh mesh = sphereGridMesh();
     Camera cam;
-    std::string err;
-    ASSERT_TRUE(makeCamera(benchmarkCamera(), &cam, &err)) << err;
-    std::vector<uint32_t> order(mesh.indices.size() / 3);
-    for (uint32_t t = 0; t < order.size(); ++t) order[t] = t;
-    const ClipBatch batch{0, uint32_t(mesh.positions.size()), order.data(), uint32_t(order.size())};
-    const ClipResult clip = clipTriangles(cam, {mesh.positions.data(), mesh.indices.data()}, {batch}, {});
+    std::vector<uint32_t> order;
+    BenchInput() {
+        std::string err;
+        EXPECT_TRUE(makeCamera(benchmarkCamera(), &cam, &err)) << err;
+        order.resize(mesh.indices.size() / 3);
+        for (uint32_t t = 0; t < order.size(); ++t) order[t] = t;
+    }
+    MeshView view() const { return {mesh.positions.data(), mesh.indices.data()}; }
+    ClipBatch first(size_t n) const { return {0, uint32_t(mesh.positions.size()), order.data(), uint32_t(n)}; }
+};
+
+// The benchmark scene: the default strategy on 2 threads against the plain walk.
+TEST(RasterTiles, BenchSceneMatchesPlainWalk) {
+    const BenchInput in;
+    const Camera &cam = in.cam;
+    const ClipResult clip = clipTriangles(cam, in.view(), {in.first(in.order.size())}, {});
     ZBufferSettings s;
     s.encoder = makeDepthEncoder(DepthFormat::f32, cam.nearZ, cam.farZ);
     const ZBufferResult want = rasterizeOn(1, clip.out, cam.width, cam.height, s, {Path::plainWalk, true, 0});
@@ -232,15 +242,10 @@ TEST(RasterTiles, RecycledStorageGivesTheSameResults) {
     EXPECT_EQ(again.buffer.id.data(), idStorage);
     expectIdentical(again, wantSmall, "recycled z-buffer");
 
-    const RawMesh mesh = sphereGridMesh();
-    Camera cam;
-    std::string err;
-    ASSERT_TRUE(makeCamera(benchmarkCamera(), &cam, &err)) << err;
-    std::vector<uint32_t> order(mesh.indices.size() / 3);
-    for (uint32_t t = 0; t < order.size(); ++t) order[t] = t;
-    const ClipBatch all{0, uint32_t(mesh.positions.size()), order.data(), uint32_t(order.size())};
-    const ClipBatch half{0, uint32_t(mesh.positions.size()), order.data(), uint32_t(order.size() / 2)};
-    const MeshView view{mesh.positions.data(), mesh.indices.data()};
+    const BenchInput in;
+    const Camera &cam = in.cam;
+    const ClipBatch all = in.first(in.order.size()), half = in.first(in.order.size() / 2);
+    const MeshView view = in.view();
     const ClipResult wantHalf = clipTriangles(cam, view, {half}, {});
     ClipResult first = clipTriangles(cam, view, {all}, {});
     const int32_t *xyStorage = first.out.xy.data();
