@@ -232,6 +232,29 @@ class RouteFileTest : public testing_util::TempDirTest {
     std::string file() const { return (dir_ / "r.route.json").string(); }
 };
 
+// fuzz_route_json's finding, byte for byte (STYLE 14): a keyframe eye at x = 5.6e51 loaded, and a
+// frame's target (eye + direction) rounded onto its eye, so the frame had no camera.
+TEST_F(RouteFileTest, FuzzFindingEyeTooFarForADirection) {
+    const std::string input =
+        "{\n"
+        "  \"format\": \"visaudit-route/1\",\n"
+        "  \"name\": \"thor-lower-loop\",\n"
+        "  \"interpolation\": \"linear\",\n"
+        "  \"speed\": 320,\n"
+        "  \"keyframes\": [\n"
+        "    { \"eye\": [-409, -563, -14], \"yaw\": 0 },\n"
+        "    { \"eye\": [1362, -563, -14], \"yaw\": 0 },\n"
+        "    { \"eye\": [1462, -663, -14], \"yaw\": -90 },\n"
+        "    { \"eye\": [1462, -926, -14], \"yaw\": -90 },\n"
+        "    { \"eye\": [555555555555555555555555555555555555555555555555551362, -1026, -14], \"yaw\": 180 },\n"
+        "    { \"eye\": [-409, -1026, -14], \"yaw\": 180 }\n"
+        "  ]\n"
+        "}\n";
+    EXPECT_EQ(loadError(input, 'z'), file() + ":11:14: keyframes[4].eye: has a coordinate beyond +-67108864, where a "
+                                             "frame's camera cannot resolve its view direction; move the route (and "
+                                             "its scene) nearer the origin");
+}
+
 TEST_F(RouteFileTest, BadRouteFilesAreRefusedWithTheFileThePlaceAndAFix) {
     const std::string head = "{\"format\": \"visaudit-route/1\", ";
     EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"target\": [0, 0, 0]}]}"),
@@ -266,6 +289,18 @@ TEST_F(RouteFileTest, BadRouteFilesAreRefusedWithTheFileThePlaceAndAFix) {
     EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0, \"pitch\": 89.99999999999}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}"),
               file() + ":1:84: keyframes[0].pitch: looks too nearly along the up axis for a camera; tilt it less "
                        "(pitch 89.99999999999)");
+    // Past kRouteMinTilt (1e-6, about 0.00006 degrees from vertical) too: a frame's eye rounding
+    // must not bring its direction to the camera model's 1e-9.
+    EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0, \"pitch\": 89.99995}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}"),
+              file() + ":1:84: keyframes[0].pitch: looks too nearly along the up axis for a camera; tilt it less "
+                       "(pitch 89.99995)");
+    EXPECT_TRUE(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0, \"pitch\": 89.9999}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}").empty());
+    // An eye beyond 2^26 (kRouteMaxCoordinate): a frame there could not resolve its direction
+    // (fuzz_route_json: eye x 5.6e51 loaded, and a frame's target rounded onto its eye).
+    EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0}, {\"eye\": [5.6e51, 0, 5], \"yaw\": 0}]}"),
+              file() + ":1:84: keyframes[1].eye: has a coordinate beyond +-67108864, where a frame's camera cannot "
+                       "resolve its view direction; move the route (and its scene) nearer the origin");
+    EXPECT_TRUE(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"yaw\": 0}, {\"eye\": [67108864, 0, -67108864], \"yaw\": 0}]}").empty());
     EXPECT_EQ(loadError(head + "\"keyframes\": [{\"eye\": [0, 0, 5], \"target\": [0, 5, 5]}, {\"eye\": [1, 0, 5], \"yaw\": 0}]}"),
               file() + ":1:75: keyframes[0].target: looks straight along the up axis (y); no yaw follows from it: move "
                        "the target sideways");

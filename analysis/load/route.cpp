@@ -275,6 +275,12 @@ bool loadRouteFile(const std::string &path, const Scene &scene, Route *out, std:
             return failed();
         }
         if (!r.vec3(j["eye"], p / "eye", &k.eye)) return failed();
+        if (!(maxAbs(k.eye) <= kRouteMaxCoordinate)) {
+            r.fail(p / "eye", "has a coordinate beyond +-" + numberText(kRouteMaxCoordinate) +
+                                  ", where a frame's camera cannot resolve its view direction; move the route "
+                                  "(and its scene) nearer the origin");
+            return failed();
+        }
         const bool hasTarget = j.contains("target"), hasYaw = j.contains("yaw");
         if (hasTarget && (hasYaw || j.contains("pitch"))) {
             r.fail(p / (hasYaw ? "yaw" : "pitch"), "give either \"target\" or \"yaw\" and \"pitch\", not both", true);
@@ -305,15 +311,18 @@ bool loadRouteFile(const std::string &path, const Scene &scene, Route *out, std:
                 return failed();
             }
         }
-        // A camera can look this way: the frames' pitch lies between their keyframes', so a
-        // direction the camera model accepts at every keyframe it accepts between them too.
+        // A camera can look this way at every frame: a frame's pitch lies between its keyframes'
+        // and its eye within kRouteMaxCoordinate * 1.6 (route.h), where target - eye is off the
+        // direction by less than 2^-25 per coordinate, so a tilt off the up axis of kRouteMinTilt
+        // at the keyframes keeps the camera model's 1e-9 at every frame.
         {
+            const Vec3 d = routeDirection(route.up, k.yaw, k.pitch);
             CameraSpec probe;
             probe.eye = {0, 0, 0};
-            probe.target = routeDirection(route.up, k.yaw, k.pitch);
+            probe.target = d;
             probe.up = load::upVector(route.up);
             Camera cam;
-            if (!makeCamera(probe, &cam, nullptr)) {
+            if (!(length(cross(d, probe.up)) > kRouteMinTilt) || !makeCamera(probe, &cam, nullptr)) {
                 r.fail(p / (hasTarget ? "target" : "pitch"),
                        "looks too nearly along the up axis for a camera; tilt it less (pitch " + numberText(k.pitch) + ")");
                 return failed();

@@ -79,6 +79,15 @@ RoutePose routePoseAt(const Route &route, double t);
 // The view direction of a yaw and pitch (degrees) about the up axis (unit length).
 Vec3 routeDirection(char up, double yawDeg, double pitchDeg);
 
+// What a route file may hold so that every frame has a camera (fuzz/fuzz_route_json.cpp). Keyframe
+// eyes lie within +-2^26 per coordinate: a frame's eye, linear or Catmull-Rom, stays within 1.6
+// times that (each tangent term is at most 4/27 of a difference of keyframe eyes, since a segment's
+// duration is at most its tangent's span), where eye + direction rounds by at most 2^-25 per
+// coordinate. Keyframe directions tilt at least kRouteMinTilt (|direction x up|, about 0.00006
+// degrees from vertical) off the up axis, far above the camera model's 1e-9 after that rounding.
+constexpr double kRouteMaxCoordinate = 67108864;  // 2^26
+constexpr double kRouteMinTilt = 1e-6;
+
 // The frames' times for the route's sampling (at most kMaxRouteFrames).
 std::vector<double> routeFrameTimes(const Route &route);
 // The route's views: ROUTE@K (K zero-padded to the width of the last frame's number), origin
