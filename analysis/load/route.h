@@ -82,7 +82,7 @@ Vec3 routeDirection(char up, double yawDeg, double pitchDeg);
 // What a route file may hold so that every frame has a camera (fuzz/fuzz_route_json.cpp). Keyframe
 // eyes lie within +-2^26 per coordinate: a frame's eye, linear or Catmull-Rom, stays within 1.6
 // times that (each tangent term is at most 4/27 of a difference of keyframe eyes, since a segment's
-// duration is at most its tangent's span), where eye + direction rounds by at most 2^-25 per
+// duration is at most its tangent's span), where eye + direction rounds by at most 2^-26 per
 // coordinate. Keyframe directions tilt at least kRouteMinTilt (|direction x up|, about 0.00006
 // degrees from vertical) off the up axis, far above the camera model's 1e-9 after that rounding.
 constexpr double kRouteMaxCoordinate = 67108864;  // 2^26
