@@ -9,17 +9,6 @@
 
 namespace va {
 
-namespace {
-
-void put(std::vector<uint8_t> &rgb, int w, int x, int y, Rgb8 c) {
-    uint8_t *p = &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3];
-    p[0] = c.r;
-    p[1] = c.g;
-    p[2] = c.b;
-}
-
-}  // namespace
-
 AuditImageNames auditImageNames(const std::string &baseName) {
     return {baseName + ".culling.png", baseName + ".raycast_diff.png", baseName + ".raycast.ids.exr"};
 }
@@ -49,28 +38,6 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
                         std::to_string(W) + "x" + std::to_string(H) + " buffers";
         return false;
     }
-    const PixelGrays gray(ref.depth, grays);
-    std::vector<uint8_t> img(n * 3);
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            const size_t i = size_t(y) * size_t(W) + size_t(x);
-            const uint8_t f = audit.fate[i];
-            Rgb8 c{0, 0, 0};
-            if (f == kFateDrawn) {
-                const uint8_t g = gray[i];
-                c = {uint8_t(g * kCullDrawnTint.r / 255), uint8_t(g * kCullDrawnTint.g / 255),
-                     uint8_t(g * kCullDrawnTint.b / 255)};
-            } else if (f == kFateUnaccounted) {
-                c = kCullUnaccounted;
-            } else if (f == kFateSnapped) {
-                c = kCullSnapped;
-            } else if (f == kFateBeyondFarPlane) {
-                c = kCullBeyondFarPlane;
-            } else if (f >= kFateCulledFirst) {
-                c = cullStageColor(f - kFateCulledFirst);
-            }
-            put(img, W, x, y, c);
-        }
     std::vector<LegendEntry> legend = {{{200, 200, 200}, "drawn"}};
     for (size_t k = 0; k < audit.stages.size(); ++k)
         legend.push_back({cullStageColor(k), "false cull: " + audit.stages[k].stage + " (" +
@@ -82,9 +49,26 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
         legend.push_back({kCullBeyondFarPlane, "beyond the map's far plane, by design (" +
                                                    std::to_string(audit.beyondFarPlanePixels) + " px)"});
     if (audit.unaccountedPixels) legend.push_back({kCullUnaccounted, "unaccounted"});
-    int CH = 0;
-    const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);
-    return writePngRgb8(path, W, CH, rgb.data(), err);
+    PaletteImage img = legendCanvas(W, H, legend);
+    // Each pixel's color from its fate, and a drawn pixel's from its depth gray, through tables.
+    uint16_t fateCode[256], drawnCode[256];
+    for (int f = 0; f < 256; ++f) {
+        Rgb8 c{0, 0, 0};
+        if (f == kFateUnaccounted) c = kCullUnaccounted;
+        else if (f == kFateSnapped) c = kCullSnapped;
+        else if (f == kFateBeyondFarPlane) c = kCullBeyondFarPlane;
+        else if (f >= kFateCulledFirst) c = cullStageColor(size_t(f - kFateCulledFirst));
+        fateCode[f] = img.codeOf(c);
+        const int g = f;
+        drawnCode[g] = img.codeOf({uint8_t(g * kCullDrawnTint.r / 255), uint8_t(g * kCullDrawnTint.g / 255),
+                                   uint8_t(g * kCullDrawnTint.b / 255)});
+    }
+    const PixelGrays gray(ref.depth, grays);
+    for (size_t i = 0; i < n; ++i) {  // the canvas is W wide: pixel i of the image is code i
+        const uint8_t f = audit.fate[i];
+        img.code[i] = f == kFateDrawn ? drawnCode[gray[i]] : fateCode[f];
+    }
+    return writePngPalette(path, img, err);
 }
 
 bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std::string &path, std::string *err,
@@ -96,26 +80,24 @@ bool writeRaycastDiffImage(const ZBuffer &zb, const CrossCheck &check, const std
                         std::to_string(W) + "x" + std::to_string(H) + " buffers";
         return false;
     }
-    const PixelGrays gray(zb.depth, grays);
-    std::vector<uint8_t> img(n * 3);
-    for (size_t i = 0; i < n; ++i) {
-        const Disagreement d = Disagreement(check.cls[i]);
-        Rgb8 c;
-        if (d == Disagreement::none) {
-            const uint8_t g = uint8_t(gray[i] / 4);  // dimmed: the classes stand out
-            c = {g, g, g};
-        } else {
-            c = disagreementColor(d);
-        }
-        img[3 * i] = c.r, img[3 * i + 1] = c.g, img[3 * i + 2] = c.b;  // row-major: pixel i at 3 i
-    }
     const std::vector<LegendEntry> legend = {
         {disagreementColor(Disagreement::edge), "edge " + std::to_string(check.edge)},
         {disagreementColor(Disagreement::tie), "tie " + std::to_string(check.tie)},
         {disagreementColor(Disagreement::genuine), "genuine " + std::to_string(check.genuine)}};
-    int CH = 0;
-    const std::vector<uint8_t> rgb = withLegend(img, W, H, legend, &CH);
-    return writePngRgb8(path, W, CH, rgb.data(), err);
+    PaletteImage img = legendCanvas(W, H, legend);
+    // Agreeing pixels dimmed gray (the classes stand out), the others their class's color.
+    uint16_t dimmed[256], classCode[256];
+    for (int k = 0; k < 256; ++k) {
+        const uint8_t g = uint8_t(k / 4);
+        dimmed[k] = img.codeOf({g, g, g});
+        classCode[k] = img.codeOf(disagreementColor(Disagreement(k)));
+    }
+    const PixelGrays gray(zb.depth, grays);
+    for (size_t i = 0; i < n; ++i) {  // the canvas is W wide: pixel i of the image is code i
+        const uint8_t d = check.cls[i];
+        img.code[i] = Disagreement(d) == Disagreement::none ? dimmed[gray[i]] : classCode[d];
+    }
+    return writePngPalette(path, img, err);
 }
 
 bool writeRaycastIds(int width, int height, const std::vector<uint32_t> &ids, const std::string &path, std::string *err,

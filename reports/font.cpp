@@ -101,7 +101,11 @@ int textWidth(std::string_view text, int scale) {
     return (int(text.size()) * kGlyphAdvance - 1) * scale;
 }
 
-int drawText(uint8_t *rgb, int w, int h, int x, int y, std::string_view text, FontColor color, int scale) {
+namespace {
+
+// Calls put(px, py) for every pixel of the text's set cells inside w x h; returns the x past it.
+template <class Put>
+int forEachTextPixel(int w, int h, int x, int y, std::string_view text, int scale, Put put) {
     if (scale < 1) return x;
     for (char c : text) {
         const Glyph *g = findGlyph(c);
@@ -114,15 +118,27 @@ int drawText(uint8_t *rgb, int w, int h, int x, int y, std::string_view text, Fo
                     for (int sx = 0; sx < scale; ++sx) {
                         const int px = x + col * scale + sx, py = y + row * scale + sy;
                         if (px < 0 || py < 0 || px >= w || py >= h) continue;
-                        uint8_t *p = rgb + (size_t(py) * size_t(w) + size_t(px)) * 3;
-                        p[0] = color.r;
-                        p[1] = color.g;
-                        p[2] = color.b;
+                        put(size_t(py) * size_t(w) + size_t(px));
                     }
             }
         x += kGlyphAdvance * scale;
     }
     return x - (text.empty() ? 0 : scale);
+}
+
+}  // namespace
+
+int drawText(uint8_t *rgb, int w, int h, int x, int y, std::string_view text, FontColor color, int scale) {
+    return forEachTextPixel(w, h, x, y, text, scale, [&](size_t i) {
+        uint8_t *p = rgb + i * 3;
+        p[0] = color.r;
+        p[1] = color.g;
+        p[2] = color.b;
+    });
+}
+
+int drawText(uint16_t *codes, int w, int h, int x, int y, std::string_view text, uint16_t code, int scale) {
+    return forEachTextPixel(w, h, x, y, text, scale, [&](size_t i) { codes[i] = code; });
 }
 
 }  // namespace va

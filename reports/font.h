@@ -32,5 +32,7 @@ inline int textHeight(int scale = 1) { return kGlyphHeight * scale; }
 // through); pixels outside the image are skipped. Returns the x just past the drawn text.
 int drawText(uint8_t *rgb, int w, int h, int x, int y, std::string_view text, FontColor color,
              int scale = 1);
+// The same into an image of one color code per pixel (reports/palette_image.h).
+int drawText(uint16_t *codes, int w, int h, int x, int y, std::string_view text, uint16_t code, int scale = 1);
 
 }  // namespace va

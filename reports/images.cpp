@@ -30,6 +30,7 @@
 
 #include "reports/font.h"
 #include "reports/legend.h"
+#include "reports/palette_image.h"
 #include "reports/report.h"
 #include "reports/audit_images.h"
 #include "reports/effects_images.h"
@@ -226,6 +227,34 @@ bool encodePng(int width, int height, int channels, const uint8_t *pixels, std::
     return encodePngRows(width, height, PNG_COLOR_TYPE_RGB, {}, pixels, 3 * size_t(width), out, why);
 }
 
+// The codes of a PaletteImage as PNG palette indices, the palette in order of first appearance:
+// the colors are distinct, so this is the palette paletteOf finds in the same pixels as RGB. False
+// when more than 256 colors appear.
+bool paletteIndices(const PaletteImage &img, std::vector<uint8_t> *index, std::vector<png_color> *colors) {
+    // slot[code]: its palette index, or -1 until it appears; order[k]: the code of palette index k.
+    // A new color is rare (a few hundred per image), so the loop is a table lookup per pixel.
+    std::vector<int16_t> slot(img.colors.size(), -1);
+    int16_t *__restrict sl = slot.data();
+    uint16_t order[256];
+    int count = 0;
+    index->resize(img.code.size());
+    const uint16_t *__restrict code = img.code.data();
+    uint8_t *__restrict out = index->data();
+    for (size_t i = 0, n = img.code.size(); i < n; ++i) {
+        const uint16_t c = code[i];
+        int s = sl[c];
+        if (s < 0) [[unlikely]] {
+            if (count == 256) return false;
+            order[count] = c;
+            s = sl[c] = int16_t(count++);
+        }
+        out[i] = uint8_t(s);
+    }
+    colors->clear();
+    for (int k = 0; k < count; ++k) colors->push_back({img.colors[order[k]].r, img.colors[order[k]].g, img.colors[order[k]].b});
+    return true;
+}
+
 // Writes encoded bytes with writeFileAtomic (in place in a report's staging folder; elsewhere a
 // temporary name, flushed, renamed over `path`: readers see the old file or the new one, never
 // half). Its errors name the call and errno's text ("No space left on device").
@@ -397,6 +426,19 @@ LegendLayout legendLayout(const std::vector<uint32_t> &values, int imageWidth) {
 
 }  // namespace
 
+bool writePngPalette(const std::string &path, const PaletteImage &image, std::string *err) {
+    const int W = image.width, H = image.height;
+    thread_local std::vector<uint8_t> index;  // kept from image to image: its pages stay mapped
+    std::vector<png_color> palette;
+    if (W <= 0 || H <= 0 || !paletteIndices(image, &index, &palette)) return writePngRgb8(path, W, H, image.rgb().data(), err);
+    std::string bytes, why;
+    if (!encodePngRows(W, H, PNG_COLOR_TYPE_PALETTE, palette, index.data(), size_t(W), &bytes, &why)) {
+        if (err) *err = "cannot write image '" + path + "': " + why;
+        return false;
+    }
+    return writeEncoded(path, bytes, err);
+}
+
 bool writePngRgb8(const std::string &path, int width, int height, const uint8_t *rgb, std::string *err) {
     return writePng(path, width, height, 3, rgb, err);
 }
@@ -562,20 +604,16 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
         const std::vector<uint32_t> values = legendValues(cap);
         const LegendLayout L = legendLayout(values, W);
         const int CW = std::max(W, L.width + 2 * L.margin), CH = H + L.stripH;
-        std::vector<uint8_t> rgb(size_t(CW) * size_t(CH) * 3);
-        fillRect(rgb, CW, 0, 0, CW, CH, kStripBackground);
+        PaletteImage img(CW, CH, kStripBackground);
         // One ramp color per fragment count, looked up per pixel (overdrawColor searches the stops
         // and rounds three channels).
-        std::vector<Rgb8> colorOf(size_t(maxFragments) + 1);
-        for (uint32_t f = 0; f <= maxFragments; ++f) colorOf[f] = overdrawColor(f, cap);
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                const Rgb8 c = colorOf[zb.fragments[size_t(y) * size_t(W) + size_t(x)]];
-                uint8_t *p = &rgb[(size_t(y) * size_t(CW) + size_t(x)) * 3];
-                p[0] = c.r;
-                p[1] = c.g;
-                p[2] = c.b;
-            }
+        std::vector<uint16_t> codeOf(size_t(maxFragments) + 1);
+        for (uint32_t f = 0; f <= maxFragments; ++f) codeOf[f] = img.codeOf(overdrawColor(f, cap));
+        for (int y = 0; y < H; ++y) {
+            const uint16_t *__restrict f = zb.fragments.data() + size_t(y) * size_t(W);
+            uint16_t *__restrict row = img.code.data() + size_t(y) * size_t(CW);
+            for (int x = 0; x < W; ++x) row[x] = codeOf[f[x]];
+        }
         // Legend, right-aligned: swatch i spans [x_i, x_i + cellW - gap) x [top, top + swatchH), with a
         // one-cell outline so that the black "0" swatch shows on the dark strip; its label is centered
         // below it.
@@ -583,13 +621,13 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
         const int x0 = CW - L.margin - L.width, top = H + L.margin;
         for (size_t i = 0; i < values.size(); ++i) {
             const int xi = x0 + int(i) * L.cellW, sw = L.cellW - L.gap;
-            fillRect(rgb, CW, xi, top, xi + sw, top + L.swatchH, kSwatchOutline);
-            fillRect(rgb, CW, xi + s, top + s, xi + sw - s, top + L.swatchH - s, overdrawColor(values[i], cap));
+            img.fill(xi, top, xi + sw, top + L.swatchH, kSwatchOutline);
+            img.fill(xi + s, top + s, xi + sw - s, top + L.swatchH - s, overdrawColor(values[i], cap));
             const std::string label = std::to_string(values[i]);
             const int lx = xi + (sw - textWidth(label, s)) / 2, ly = top + L.swatchH + 2 * s;
-            drawText(rgb.data(), CW, CH, lx, ly, label, {kLegendText.r, kLegendText.g, kLegendText.b}, s);
+            img.text(lx, ly, label, kLegendText, s);
         }
-        if (!writePng(prefix + names.overdrawPng, CW, CH, 3, rgb.data(), err)) return false;
+        if (!writePngPalette(prefix + names.overdrawPng, img, err)) return false;
     }
 
     // BASE.ids.exr: 1 + visible source triangle index as UINT32 (OpenEXR's 32-bit unsigned pixel

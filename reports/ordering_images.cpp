@@ -32,40 +32,39 @@ OrderingImageNames orderingImageNames(const std::string &baseName) {
     return {baseName + ".painter_errors.png", baseName + ".overdraw_order.png", baseName + ".abuffer.png"};
 }
 
-std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH,
-                                         const std::vector<uint8_t> *grays) {
+PaletteImage renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter,
+                                 const std::vector<uint8_t> *grays) {
     const int W = ref.width, H = ref.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
-    // The reference's depths as the dimmed gray background (log scale, as depth.png).
-    const PixelGrays gray(ref.depth, grays);
     const int scale = W >= 1024 ? 2 : 1;
     const int strip = 13 * scale;
-    *canvasH = H + strip;
-    std::vector<uint8_t> rgb(size_t(W) * size_t(*canvasH) * 3, 0);
+    PaletteImage img(W, H + strip, {0, 0, 0});
+    // The reference's depths as the dimmed gray background (log scale, as depth.png); the classes'
+    // colors over it. Codes through tables: pixel i of the image is code i (the canvas is W wide).
+    const PixelGrays gray(ref.depth, grays);
+    uint16_t dimmed[256];
+    for (int k = 0; k < 256; ++k) {
+        const uint8_t g = uint8_t(k / 2);
+        dimmed[k] = img.codeOf({g, g, g});
+    }
+    const uint16_t black = img.codeOf({0, 0, 0}), wrong = img.codeOf(kOrderWrongColor),
+                   tie = img.codeOf(kOrderTieColor), edge = img.codeOf(kOrderEdgeColor);
     for (size_t i = 0; i < n && i < painter.cls.size(); ++i) {
-        Rgb8 c{0, 0, 0};
-        if (painter.cls[i] == kOrderWrong) c = kOrderWrongColor;
-        else if (painter.cls[i] == kOrderTie) c = kOrderTieColor;
-        else if (painter.cls[i] == kOrderEdge) c = kOrderEdgeColor;
-        else if (ref.id[i]) {
-            const uint8_t g = uint8_t(gray[i] / 2);
-            c = {g, g, g};
-        }
-        uint8_t *p = &rgb[i * 3];
-        p[0] = c.r, p[1] = c.g, p[2] = c.b;
+        const uint8_t c = painter.cls[i];
+        img.code[i] = c == kOrderWrong ? wrong : c == kOrderTie ? tie : c == kOrderEdge ? edge : ref.id[i] ? dimmed[gray[i]] : black;
     }
     // Legend: swatch + text, in one row below the image.
     int x = 3 * scale;
     const int y = H + 3 * scale;
     auto entry = [&](Rgb8 c, const std::string &label) {
-        fill(rgb, W, x, y, x + 7 * scale, y + 7 * scale, c);
-        x = drawText(rgb.data(), W, *canvasH, x + 10 * scale, y, label, {230, 230, 230}, scale) + 8 * scale;
+        img.fill(x, y, x + 7 * scale, y + 7 * scale, c);
+        x = img.text(x + 10 * scale, y, label, {230, 230, 230}, scale) + 8 * scale;
     };
     entry(kOrderWrongColor, "painter wrong: " + std::to_string(painter.wrongPixels) + " px");
     entry(kOrderTieColor, "depth tie: " + std::to_string(painter.tiePixels) + " px");
     entry(kOrderEdgeColor, "edge: " + std::to_string(painter.edgePixels) + " px");
     entry({128, 128, 128}, std::string("key: ") + painterKeyName(painter.key));
-    return rgb;
+    return img;
 }
 
 bool writePainterErrorsImage(const ReferenceVisibility &ref, const PainterResult &painter, const std::string &path,
@@ -75,9 +74,7 @@ bool writePainterErrorsImage(const ReferenceVisibility &ref, const PainterResult
         if (err) *err = "cannot write image '" + path + "': the painter's per-pixel classes do not match the reference";
         return false;
     }
-    int h = 0;
-    const std::vector<uint8_t> rgb = renderPainterErrors(ref, painter, &h, grays);
-    return writePngRgb8(path, ref.width, h, rgb.data(), err);
+    return writePngPalette(path, renderPainterErrors(ref, painter, grays), err);
 }
 
 std::vector<uint8_t> renderOverdrawByOrder(const std::vector<OrderOverdraw> &orders, int *canvasH) {

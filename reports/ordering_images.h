@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "analysis/audits/ordering.h"
+#include "reports/palette_image.h"
 #include "reports/report.h"
 
 namespace va {
@@ -30,10 +31,10 @@ constexpr Rgb8 kOrderWrongColor{255, 32, 32};
 constexpr Rgb8 kOrderTieColor{255, 220, 0};
 constexpr Rgb8 kOrderEdgeColor{64, 128, 255};
 
-// The painter-errors picture as RGB8 (width x (height + legend)); *canvasH receives its height.
+// The painter-errors picture (width x (height + legend)).
 // grays (both): the reference depth's depthGrays when the caller has them (else computed here).
-std::vector<uint8_t> renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter, int *canvasH,
-                                         const std::vector<uint8_t> *grays = nullptr);
+PaletteImage renderPainterErrors(const ReferenceVisibility &ref, const PainterResult &painter,
+                                 const std::vector<uint8_t> *grays = nullptr);
 bool writePainterErrorsImage(const ReferenceVisibility &ref, const PainterResult &painter, const std::string &path,
                              std::string *err, const std::vector<uint8_t> *grays = nullptr);
 

@@ -6,8 +6,7 @@
 //      the smaller ones' outlines stay on top), with its id above the box (below when no room);
 //   4. the hotspot pixels, filled with their hotspot's color;
 //   5. the legend strip below the view.
-// Written through OpenImageIO with the same temporary-name-then-rename protocol as
-// reports/images.cpp (whose writer is file-local; this file keeps its own copy, as depth_plot.cpp).
+// Drawn as color codes (reports/palette_image.h) and written by writePngPalette.
 #include "reports/zfight_image.h"
 
 
@@ -28,20 +27,6 @@ constexpr Rgb8 kPalette[12] = {
 };
 constexpr Rgb8 kLegendText{255, 255, 255};
 
-
-struct Canvas {
-    int w = 0, h = 0;
-    std::vector<uint8_t> *rgb = nullptr;
-    void set(int x, int y, Rgb8 c) {
-        if (x < 0 || y < 0 || x >= w || y >= h) return;
-        uint8_t *p = &(*rgb)[(size_t(y) * size_t(w) + size_t(x)) * 3];
-        p[0] = c.r, p[1] = c.g, p[2] = c.b;
-    }
-    void fill(int x0, int y0, int x1, int y1, Rgb8 c) {  // [x0, x1) x [y0, y1)
-        for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x) set(x, y, c);
-    }
-};
 
 // Legend layout, in multiples of the font scale s: a line is swatch 7s, gap 2s, label, gap 6s per
 // entry; lines are margin 3s + text 7s apart by 3s; entries wrap at the view's width.
@@ -93,60 +78,70 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     const int CH = H + stripH;
 
     ZFightImage img;
-    img.width = CW;
-    img.height = CH;
+    static_cast<PaletteImage &>(img) = PaletteImage(CW, CH, kZFightStripBackground);
     img.viewWidth = W;
     img.viewHeight = H;
-    img.rgb.assign(size_t(CW) * size_t(CH) * 3, 0);
-    Canvas c{CW, CH, &img.rgb};
-    c.fill(0, 0, CW, CH, kZFightStripBackground);
+    const size_t cw = size_t(CW);
 
-    // 1. Dimmed gray view; 2. markers.
+    // 1. Dimmed gray view; 2. markers (codes through tables).
     const PixelGrays gray(zb.depth, grays);
-    for (int y = 0; y < H; ++y)
+    uint16_t dimmed[256];
+    for (int k = 0; k < 256; ++k) {
+        const uint8_t g = uint8_t(k / 2);
+        dimmed[k] = img.codeOf({g, g, g});
+    }
+    const uint16_t sharedEdge = img.codeOf(kZFightSharedEdgeColor), intersection = img.codeOf(kZFightIntersectionColor);
+    for (int y = 0; y < H; ++y) {
+        uint16_t *row = img.code.data() + size_t(y) * cw;
         for (int xx = 0; xx < W; ++xx) {
             const size_t p = size_t(y) * size_t(W) + size_t(xx);
-            const uint8_t g = uint8_t(gray[p] / 2);
-            Rgb8 col{g, g, g};
             const auto cls = ZPixelClass(zf.pixelClass[p]);
-            if (cls == ZPixelClass::shared_edge) col = kZFightSharedEdgeColor;
-            else if (cls == ZPixelClass::intersection) col = kZFightIntersectionColor;
-            c.set(xx, y, col);
+            row[xx] = cls == ZPixelClass::shared_edge    ? sharedEdge
+                      : cls == ZPixelClass::intersection ? intersection
+                                                         : dimmed[gray[p]];
         }
+    }
 
-    // 3. Outlines and ids of the listed hotspots, largest (id 1) drawn first.
+    // 3. Outlines and ids of the listed hotspots, largest (id 1) drawn first; only inside the view
+    // (the canvas' rows above the strip and its first W columns).
+    auto setInView = [&](int x, int y, uint16_t c) {
+        if (x >= 0 && y >= 0 && x < W && y < H) img.code[size_t(y) * cw + size_t(x)] = c;
+    };
     for (const ZFightHotspot &h : zf.hotspots) {
         const Rgb8 col = zfightHotspotColor(h.id);
+        const uint16_t c = img.codeOf(col);
         const int x0 = h.minX - 2, y0 = h.minY - 2, x1 = h.maxX + 2, y1 = h.maxY + 2;
         for (int xx = std::max(x0, 0); xx <= std::min(x1, W - 1); ++xx) {
-            if (y0 >= 0) c.set(xx, y0, col);
-            if (y1 < H) c.set(xx, y1, col);
+            if (y0 >= 0) setInView(xx, y0, c);
+            if (y1 < H) setInView(xx, y1, c);
         }
         for (int y = std::max(y0, 0); y <= std::min(y1, H - 1); ++y) {
-            if (x0 >= 0 && x0 < W) c.set(x0, y, col);
-            if (x1 >= 0 && x1 < W) c.set(x1, y, col);
+            if (x0 >= 0 && x0 < W) setInView(x0, y, c);
+            if (x1 >= 0 && x1 < W) setInView(x1, y, c);
         }
         const std::string label = std::to_string(h.id);
         const int ly = y0 - 1 - textHeight(s) >= 0 ? y0 - 1 - textHeight(s) : std::min(y1 + 2, H - textHeight(s));
-        // Only inside the view's rows: drawText clips to the w x h it is given (the canvas' rows
-        // above the strip).
-        if (ly >= 0) drawText(img.rgb.data(), CW, H, std::max(x0, 0), ly, label, {col.r, col.g, col.b}, s);
+        // Only inside the view's rows: the text is clipped to the canvas' rows above the strip.
+        if (ly >= 0) img.text(std::max(x0, 0), ly, label, col, s, H);
     }
 
     // 4. Hotspot pixels.
+    std::vector<uint16_t> hotspotCode(zf.hotspots.size() + 1);
+    for (size_t k = 1; k < hotspotCode.size(); ++k) hotspotCode[k] = img.codeOf(zfightHotspotColor(uint32_t(k)));
+    const uint16_t other = img.codeOf(kZFightOtherHotspotColor);
     for (int y = 0; y < H; ++y)
         for (int xx = 0; xx < W; ++xx) {
             const uint32_t id = zf.hotspotOf[size_t(y) * size_t(W) + size_t(xx)];
             if (!id) continue;
-            c.set(xx, y, id <= zf.hotspots.size() ? zfightHotspotColor(id) : kZFightOtherHotspotColor);
+            img.code[size_t(y) * cw + size_t(xx)] = id < hotspotCode.size() ? hotspotCode[id] : other;
         }
 
     // 5. Legend.
     for (size_t i = 0; i < entries.size(); ++i) {
         const int ex = xOf[i], ey = H + margin + lineOf[i] * lineH;
-        if (entries[i].label != "no hotspots") c.fill(ex, ey, ex + swatch, ey + swatch, entries[i].color);
+        if (entries[i].label != "no hotspots") img.fill(ex, ey, ex + swatch, ey + swatch, entries[i].color);
         const int tx = entries[i].label == "no hotspots" ? ex : ex + swatch + 2 * s;
-        drawText(img.rgb.data(), CW, CH, tx, ey, entries[i].label, {kLegendText.r, kLegendText.g, kLegendText.b}, s);
+        img.text(tx, ey, entries[i].label, kLegendText, s);
     }
     *out = std::move(img);
     return true;
@@ -160,7 +155,7 @@ bool writeZFightImage(const ZFightResult &zf, const ZBuffer &zb, const std::stri
         if (err) *err = "cannot write image '" + path + "': " + e;
         return false;
     }
-    return writePngRgb8(path, img.width, img.height, img.rgb.data(), err);
+    return writePngPalette(path, img, err);
 }
 
 }  // namespace va

@@ -13,6 +13,7 @@
 
 #include "analysis/audits/zfight.h"
 #include "render/raster.h"
+#include "reports/palette_image.h"
 #include "reports/report.h"
 
 namespace va {
@@ -25,17 +26,11 @@ constexpr Rgb8 kZFightIntersectionColor{170, 150, 100};  // khaki: fights on an 
 constexpr Rgb8 kZFightOtherHotspotColor{255, 255, 255};  // hotspots beyond the listed ones
 constexpr Rgb8 kZFightStripBackground{24, 24, 24};
 
-// The image in memory (interleaved RGB8, rows top-down): the view occupies rows [0, viewHeight) and
-// columns [0, viewWidth); the legend strip is rows [viewHeight, height). The canvas is wider than
+// The image in memory (a color code per pixel, rows top-down): the view occupies rows
+// [0, viewHeight) and columns [0, viewWidth); the legend strip is rows [viewHeight, height). The canvas is wider than
 // the view only when the legend's longest line needs it (filled with the strip color).
-struct ZFightImage {
-    int width = 0, height = 0;
+struct ZFightImage : PaletteImage {
     int viewWidth = 0, viewHeight = 0;
-    std::vector<uint8_t> rgb;
-    Rgb8 at(int x, int y) const {
-        const uint8_t *p = &rgb[(size_t(y) * size_t(width) + size_t(x)) * 3];
-        return {p[0], p[1], p[2]};
-    }
 };
 
 // Composes the image from the analysis and the view's z-buffer (its visible depth is the gray

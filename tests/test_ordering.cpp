@@ -382,9 +382,10 @@ TEST(Ordering, Images) {
     const OrderingView v = prepareOrderingView(s, cam);
     const PainterResult p = paintersAlgorithm(v, ref, PainterKey::centroid);
     ASSERT_GT(p.wrongPixels, 0u);
-    int h = 0;
-    const std::vector<uint8_t> img = renderPainterErrors(ref, p, &h);
-    ASSERT_GT(h, 120);
+    const PaletteImage pic = renderPainterErrors(ref, p);
+    ASSERT_EQ(pic.width, 120);
+    ASSERT_GT(pic.height, 120);
+    const std::vector<uint8_t> img = pic.rgb();
     uint64_t red = 0;
     for (size_t i = 0; i < size_t(120) * 120; ++i)
         red += img[3 * i] == kOrderWrongColor.r && img[3 * i + 1] == kOrderWrongColor.g && img[3 * i + 2] == kOrderWrongColor.b;

@@ -22,6 +22,7 @@
 #include "reports/console.h"
 #include "reports/font.h"
 #include "reports/html.h"
+#include "reports/palette_image.h"
 #include "reports/report.h"
 
 namespace va {
@@ -901,6 +902,41 @@ TEST(ReportImages, PngDirectIdatEqualsLibpngRows) {
         const std::string want = libpngRows(c.W, c.H, rgb);
         ASSERT_FALSE(want.empty());
         EXPECT_TRUE(fileBytes(path) == want) << c.W << "x" << c.H << ", " << c.colors << " colors";
+    }
+}
+
+// A picture drawn as color codes (PaletteImage) is written byte for byte as its RGB pixels are by
+// writePngRgb8: the palette in order of first appearance whatever order the codes were made in
+// (colors asked for and never drawn leave no entry), RGB past 256 colors, and the legend's text.
+TEST(ReportImages, PaletteImageWritesTheBytesOfItsRgbPixels) {
+    TempDir dir;
+    struct Case {
+        int W, H, colors;
+    };
+    for (const Case c : {Case{300, 200, 6}, Case{300, 200, 255}, Case{300, 200, 256}, Case{300, 200, 257},
+                         Case{641, 480, 2000}, Case{1, 20000, 12}, Case{20000, 1, 12}, Case{1920, 1080, 40}}) {
+        PaletteImage img(c.W, c.H, {24, 24, 24});
+        // Codes asked for in reverse order of use, plus some never drawn.
+        std::vector<uint16_t> code(size_t(c.colors));
+        for (int k = c.colors - 1; k >= 0; --k) {
+            const uint32_t v = uint32_t(k) * 40503u + 7u;
+            code[size_t(k)] = img.codeOf({uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16)});
+            if (k % 5 == 0) img.codeOf({uint8_t(k), 1, 2});  // never drawn (unless equal to a drawn one)
+        }
+        for (int y = 0; y < c.H; ++y)
+            for (int x = 0; x < c.W; ++x) {
+                const int yy = y - y % 7, xx = x - x % 13;  // bands of repeated rows and runs
+                img.code[size_t(y) * size_t(c.W) + size_t(x)] = code[size_t((yy * 31 + xx * 17) * 2654435761u % uint32_t(c.colors))];
+            }
+        img.fill(2, 2, 40, 9, Rgb8{255, 0, 255});
+        img.text(3, 3, "legend 0123", {255, 255, 255}, 1, c.H / 2);
+        const std::vector<uint8_t> rgb = img.rgb();
+        ASSERT_EQ(rgb.size(), size_t(c.W) * size_t(c.H) * 3);
+        std::string err;
+        ASSERT_TRUE(writePngRgb8(dir.path + "/rgb.png", c.W, c.H, rgb.data(), &err)) << err;
+        ASSERT_TRUE(writePngPalette(dir.path + "/codes.png", img, &err)) << err;
+        EXPECT_TRUE(fileBytes(dir.path + "/codes.png") == fileBytes(dir.path + "/rgb.png"))
+            << c.W << "x" << c.H << ", " << c.colors << " colors";
     }
 }
 

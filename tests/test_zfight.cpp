@@ -811,7 +811,7 @@ TEST(ZFightImage, HotspotsInTheirColorsMarkersAndLegend) {
     ASSERT_TRUE(readImage(path, &back, &err)) << err;
     EXPECT_EQ(back.width, img.width);
     EXPECT_EQ(back.height, img.height);
-    EXPECT_EQ(back.u8, img.rgb);
+    EXPECT_EQ(back.u8, img.rgb());
     for (const auto &e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().filename().string(), "view.zfight.png");
     fs::remove_all(dir);
     // A folder that does not exist: an error naming the path, no file.
