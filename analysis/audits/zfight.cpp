@@ -533,38 +533,62 @@ namespace {
 //    encoded one by one.
 void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &settings, ZFightResult &r) {
     const size_t N = two.pixels(), F = settings.formats.size();
-    std::vector<uint32_t> pixel;
-    std::vector<double> near1, near2;
-    pixel.reserve(r.twoSurfacePixels);  // counted by the caller: no regrowth
-    near1.reserve(r.twoSurfacePixels);
-    near2.reserve(r.twoSurfacePixels);
+    // The two-surface pixels' lists, sized by the caller's count (the thread's storage, kept from
+    // view to view: only its first n2 entries are this view's).
+    thread_local std::vector<uint32_t> pixel;
+    thread_local std::vector<double> near1, near2;
+    if (pixel.size() < r.twoSurfacePixels) {
+        pixel.resize(r.twoSurfacePixels);
+        near1.resize(r.twoSurfacePixels);
+        near2.resize(r.twoSurfacePixels);
+    }
     double oneMin = kInf, oneMax = -kInf;
     bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
-    double twoMin = kInf, twoMax = 0;  // finite positive depths of the two-surface pixels
-    for (size_t p = 0; p < N; ++p) {
-        if (two.screen1[p] == kNoFragment) continue;
-        const double d1 = two.depth1[p];
-        if (two.screen2[p] != kNoFragment) {
-            const double d2 = two.depth2[p];
-            pixel.push_back(uint32_t(p));
-            near1.push_back(d1);
-            near2.push_back(d2);
-            for (const double d : {d1, d2})
-                if (d > 0 && std::isfinite(d)) twoMin = std::min(twoMin, d), twoMax = std::max(twoMax, d);
-        } else {
-            oneMin = std::min(oneMin, d1);
-            oneMax = std::max(oneMax, d1);
-            oneUnordered |= d1 != d1;
+    size_t n2 = 0;
+    {
+        uint32_t *__restrict px = pixel.data();
+        double *__restrict a = near1.data(), *__restrict b = near2.data();
+        for (size_t p = 0; p < N; ++p) {
+            if (two.screen1[p] == kNoFragment) continue;
+            const double d1 = two.depth1[p];
+            if (two.screen2[p] != kNoFragment) {
+                px[n2] = uint32_t(p);
+                a[n2] = d1;
+                b[n2] = two.depth2[p];
+                ++n2;
+            } else {
+                oneMin = std::min(oneMin, d1);
+                oneMax = std::max(oneMax, d1);
+                oneUnordered |= d1 != d1;
+            }
         }
     }
-    const size_t n2 = pixel.size();
-    std::vector<uint32_t> mask(n2, 0);
+    // The finite positive depths' range of the two-surface pixels, over the gathered lists in four
+    // independent lanes (one running minimum would wait on the previous one's latency at every
+    // pixel); the smallest and largest of a set of such numbers do not depend on the order.
+    double twoMin = kInf, twoMax = 0;
+    {
+        double lo[4] = {kInf, kInf, kInf, kInf}, hi[4] = {0, 0, 0, 0};
+        for (const std::vector<double> *list : {&near1, &near2}) {
+            const double *d = list->data();  // its first n2
+            for (size_t k = 0; k < n2; ++k) {
+                const double x = d[k];
+                const bool ok = x > 0 && x < kInf;  // finite and positive (false for NaN)
+                lo[k & 3] = ok && x < lo[k & 3] ? x : lo[k & 3];
+                hi[k & 3] = ok && x > hi[k & 3] ? x : hi[k & 3];
+            }
+        }
+        for (int j = 0; j < 4; ++j) twoMin = std::min(twoMin, lo[j]), twoMax = std::max(twoMax, hi[j]);
+    }
+    thread_local std::vector<uint32_t> mask, cell1, cell2, unsafe;  // per two-surface pixel, as above
+    if (mask.size() < n2) mask.resize(n2), cell1.resize(n2), cell2.resize(n2);
+    std::fill_n(mask.begin(), n2, 0u);
 
     // 2a. The pixels that cannot fight in any filtered format are set aside.
     std::vector<DepthEncoder> enc(F);
     for (size_t i = 0; i < F; ++i) enc[i] = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
     const FightFilter filter(enc, n2 ? twoMin : 0, twoMax);
-    std::vector<uint32_t> cell1(n2), cell2(n2), unsafe;  // unsafe: indices into the two-surface list
+    unsafe.clear();  // indices into the two-surface list
     for (size_t k = 0; k < n2; ++k) {
         cell1[k] = filter.cell(near1[k]);
         cell2[k] = filter.cell(near2[k]);
@@ -680,11 +704,23 @@ void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &
         std::vector<uint64_t> formatPixels;
     };
     std::vector<Component> comps;
-    std::vector<uint32_t> label(N, 0);  // 1-based component index; 0 = none
+    // The components' labels (1-based component index; 0 = none) are kept in r.hotspotOf, all 0 on
+    // entry, and replaced by the hotspot ids at the end.
+    std::vector<uint32_t> &label = r.hotspotOf;
     std::vector<size_t> stack, members;
     std::vector<double> depths, gaps;
+    const uint8_t *cls = r.pixelClass.data();
     for (size_t seed = 0; seed < N; ++seed) {
-        if (label[seed] || !isHotspotPixel(seed)) continue;
+        // Most pixels fight nowhere (class none = 0): eight of them skipped at a time.
+        if ((seed & 7) == 0 && seed + 8 <= N) {
+            uint64_t eight;
+            std::memcpy(&eight, cls + seed, sizeof eight);
+            if (eight == 0) {
+                seed += 7;
+                continue;
+            }
+        }
+        if (!isHotspotPixel(seed) || label[seed]) continue;
         comps.emplace_back();
         const uint32_t id = uint32_t(comps.size());
         Component &cp = comps.back();
@@ -767,8 +803,8 @@ void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &
         explainHotspot(cam.nearZ, cam.farZ, settings.viewFormat, h.coplanarPixels == h.area, &h);
         r.hotspots.push_back(std::move(h));
     }
-    for (size_t p = 0; p < N; ++p)
-        if (label[p]) r.hotspotOf[p] = idOfComp[label[p] - 1];
+    for (size_t p = 0; p < N; ++p)  // every hotspot pixel has a label, and only they
+        if (isHotspotPixel(p)) label[p] = idOfComp[label[p] - 1];
 
 }
 
