@@ -188,10 +188,15 @@ struct PacketRays {
     const RayGen &gen;
     const Camera &cam;
     std::vector<Vec3> cols, rows;
+    // The same terms by component (perspective), for a whole packet's directions in loops the
+    // compiler vectorizes: direction = (column + row) + forward per component, as RayGen::combine.
+    std::vector<double> colX, colY, colZ, rowX, rowY, rowZ;
 
     PacketRays(const RayGen &g, const Camera &c) : gen(g), cam(c), cols(size_t(c.width)), rows(size_t(c.height)) {
         for (int x = 0; x < c.width; ++x) cols[size_t(x)] = g.column(x);
         for (int y = 0; y < c.height; ++y) rows[size_t(y)] = g.row(y);
+        for (const Vec3 &v : cols) colX.push_back(v.x), colY.push_back(v.y), colZ.push_back(v.z);
+        for (const Vec3 &v : rows) rowX.push_back(v.x), rowY.push_back(v.y), rowZ.push_back(v.z);
     }
     // The fields Embree never writes, and the perspective origin (the eye, for every ray).
     void init(RTCRayHit16 &rh) const {
@@ -210,6 +215,26 @@ struct PacketRays {
     // The rays of the packet whose top-left pixel is (px, py); lanes outside the image are invalid
     // (lane i is pixel (px + i % 4, py + i / 4)).
     void fill(int px, int py, RTCRayHit16 &rh, int valid[16]) const {
+        if (!gen.ortho && px + kPacket <= cam.width && py + kPacket <= cam.height) {
+            // A whole perspective packet: the origin is init()'s eye; the same operations in the
+            // same order as combine(), four rays of a packet row at a time.
+            const float far = float(cam.farZ);
+            for (int j = 0; j < kPacket; ++j) {
+                const size_t y = size_t(py + j);
+                const double rx = rowX[y], ry = rowY[y], rz = rowZ[y];
+                const double *cx = colX.data() + px, *cy = colY.data() + px, *cz = colZ.data() + px;
+                for (int i = 0; i < kPacket; ++i) {
+                    const int l = kPacket * j + i;
+                    rh.ray.dir_x[l] = float((cx[i] + rx) + gen.fw.x);
+                    rh.ray.dir_y[l] = float((cy[i] + ry) + gen.fw.y);
+                    rh.ray.dir_z[l] = float((cz[i] + rz) + gen.fw.z);
+                    rh.ray.tfar[l] = far;
+                    rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+                    valid[l] = -1;
+                }
+            }
+            return;
+        }
         for (int i = 0; i < 16; ++i) {
             const int x = px + (i & 3), y = py + (i >> 2);
             valid[i] = (x < cam.width && y < cam.height) ? -1 : 0;
@@ -299,19 +324,21 @@ void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int ban
     const auto u = std::make_unique_for_overwrite<float[]>(kBary ? count : 0);
     const auto v = std::make_unique_for_overwrite<float[]>(kBary ? count : 0);
     st.rays += count;
+    uint64_t hits = 0, packets = 0;  // in registers, not through `st`
+    const uint32_t *toSource = primToSource.data();
     rays.forEachPacket(band, [](int, int, int) {}, [&](int px, int py) {
         rays.fill(px, py, rh, valid);
         if constexpr (kTies) fc.resetLanes();
         rtcIntersect16(valid, scene, &fc.ctx, &rh);
-        ++st.packets;
+        ++packets;
         // Branch-free over the lanes: a miss keeps tfar = far and geomID invalid, and Embree leaves
         // primID as it was (init()'s 0 or an earlier hit), always a valid index.
         for (int i = 0; i < 16; ++i) {
             if (!valid[i]) continue;
             const bool hit = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-            st.hits += hit;
+            hits += hit;
             const size_t p = size_t(py - y0 + (i >> 2)) * w + size_t(px + (i & 3));
-            id[p] = hit ? 1 + primToSource[rh.hit.primID[i]] : 0;
+            id[p] = hit ? 1 + toSource[rh.hit.primID[i]] : 0;
             depth[p] = hit ? rh.ray.tfar[i] : float(INFINITY);
             if constexpr (kBary) {
                 u[p] = hit ? rh.hit.u[i] : 0.0f;
@@ -319,6 +346,8 @@ void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int ban
             }
         }
     });
+    st.hits += hits;
+    st.packets += packets;
     streamCopy(id.get(), count, img.id.data() + begin);
     streamCopy(depth.get(), count, img.depth.data() + begin);
     if constexpr (kBary) {
