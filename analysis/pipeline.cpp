@@ -175,6 +175,7 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
                               makeDepthEncoder(c.view.depthFormat, c.cam.nearZ, c.cam.farZ), ps.rays->origin());
     ray.crossCheck.culled = culledPixels;
     ray.crossCheck.recast = culledPixels > 0;
+    recycleRaycastImage(sameSet);
     if (!ps.effects.tracesRays()) r.effects.skip("the scene calls for no secondary rays");
     else if (!c.stopped()) r.effects = traceEffects(*ps.rays, c.cam, ray.image, effectsInputFor(ps.effectsData, ps.effects));
 }

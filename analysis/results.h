@@ -101,7 +101,7 @@ struct RaycastResult {
     CrossCheck crossCheck;
     RaycastImage image;               // ids/depths for NAME.raycast.ids.exr (released after writing)
     void releasePixels() {
-        image = RaycastImage{};
+        recycleRaycastImage(image);  // for a later view's cast
         std::vector<uint8_t>().swap(crossCheck.cls);
     }
 };

@@ -1,6 +1,7 @@
 #include "render/raycast.h"
 
 #include "render/large_pages.h"
+#include "render/recycle.h"
 
 #include <algorithm>
 #include <cmath>
@@ -374,13 +375,22 @@ void castBands(RTCScene scene, const FilterContext &proto, const PacketRays &ray
 }
 }  // namespace
 
+void recycleRaycastImage(RaycastImage &img) {
+    RaycastImage kept = std::move(img);
+    img = RaycastImage{};
+    if (kept.id.capacity() + kept.depth.capacity() + kept.u.capacity() + kept.v.capacity() == 0) return;
+    kept.width = kept.height = 0;
+    kept.id.clear(), kept.depth.clear(), kept.u.clear(), kept.v.clear();
+    recyclerOf<RaycastImage>().give(std::move(kept));
+}
+
 RaycastImage RayScene::castPrimary(const Camera &cam, RaycastStats *stats) const {
     return castPrimary(cam, PrimaryOptions{}, stats);
 }
 
 RaycastImage RayScene::castPrimary(const Camera &cam, const PrimaryOptions &opt, RaycastStats *stats) const {
     const Impl &m = *impl_;
-    RaycastImage img;
+    RaycastImage img = recyclerOf<RaycastImage>().take();  // a finished view's, when one gave it back
     img.width = cam.width;
     img.height = cam.height;
     const size_t n = size_t(cam.width) * cam.height;

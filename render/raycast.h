@@ -34,6 +34,11 @@ struct RaycastImage {
     std::vector<float> u, v;
 };
 
+// Storage handed to the next view (render/recycle.h): a finished view gives its ray-cast image
+// back, emptied, and the next castPrimary fills it instead of faulting fresh pages in (img is left
+// empty).
+void recycleRaycastImage(RaycastImage &img);
+
 struct RaycastStats {
     uint64_t rays = 0;     // primary rays cast (one per pixel)
     uint64_t hits = 0;     // rays that hit a triangle
