@@ -1,7 +1,11 @@
 // BSP build on a real level (docs/ordering.md, "Speed"): OpenArena's oa_thor (scripts/fetch-data.sh
 // puts pak6-patch088.pk3 in data/openarena/), or any scene given as the first argument.
 //
-//   build-order/bench/bench_bsp [SCENE] [--reps N] [--views N]
+//   build-order/bench/bench_bsp [SCENE] [--reps N] [--views N] [--tile N]
+//
+// --tile N: the scene's triangles N times side by side along x (each copy a source object of its
+// own, a gap of a tenth of the level's width between copies): a level of N times the triangles for
+// the BSP build's floor (issue 18: at most 1 s for 100k triangles; --tile 3 of oa_thor is 129k).
 //
 // Per heuristic (default, fewest splits, balance, and the default with every piece scored): build
 // time (best and median of N), splits next to the worst case (a BSP of n triangles can need
@@ -22,11 +26,40 @@
 
 using namespace va;
 
+namespace {
+
+// The scene's source objects `copies` times side by side along x (materials kept; views, lights
+// and the map's BSP data dropped).
+Scene tiled(const Scene &scene, int copies) {
+    SceneBuildInput in;
+    in.up = scene.up;
+    in.materials = scene.materials;
+    const double width = scene.bounds.hi.x - scene.bounds.lo.x, step = width * 1.1;
+    for (int k = 0; k < copies; ++k)
+        for (const SourceObject &src : scene.sources) {
+            SceneBuildInput::Object o;
+            o.name = src.name + "@" + std::to_string(k);
+            o.mesh = src.mesh;
+            o.material = src.material;
+            for (uint32_t t = src.firstTriangle; t < src.firstTriangle + src.triangleCount; ++t)
+                for (int j = 0; j < 3; ++j) {
+                    o.geometry.indices.push_back(uint32_t(o.geometry.positions.size()));
+                    o.geometry.positions.push_back(scene.positions[scene.indices[3 * size_t(t) + size_t(j)]] +
+                                                   Vec3{step * k, 0, 0});
+                }
+            in.objects.push_back(std::move(o));
+        }
+    return buildScene(std::move(in));
+}
+
+}  // namespace
+
 int main(int argc, char **argv) {
     std::string path = std::string(VISAUDIT_SOURCE_DIR) + "/data/openarena/pak6-patch088.pk3:maps/oa_thor.bsp";
-    int reps = 3, nViews = 2;
+    int reps = 3, nViews = 2, tile = 1;
     for (int i = 1; i < argc; ++i) {
         if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
+        else if (!std::strcmp(argv[i], "--tile") && i + 1 < argc) tile = std::clamp(std::atoi(argv[++i]), 1, 64);
         else if (!std::strcmp(argv[i], "--views") && i + 1 < argc) nViews = std::max(0, std::atoi(argv[++i]));
         else path = argv[i];
     }
@@ -41,7 +74,9 @@ int main(int argc, char **argv) {
         std::fprintf(stderr, "bench_bsp: %s\n", err.c_str());
         return 2;
     }
-    std::printf("%s: %zu source triangles, %zu objects\n", path.c_str(), scene.triangleCount(), scene.objects.size());
+    if (tile > 1) scene = tiled(scene, tile);
+    std::printf("%s%s: %zu source triangles, %zu objects\n", path.c_str(),
+                tile > 1 ? (" x" + std::to_string(tile)).c_str() : "", scene.triangleCount(), scene.objects.size());
 
     struct Config {
         const char *name;
