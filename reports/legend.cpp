@@ -9,21 +9,8 @@ namespace va {
 namespace {
 constexpr Rgb8 kStrip{24, 24, 24};
 constexpr Rgb8 kText{255, 255, 255};
-}  // namespace
 
-void fillRect(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c) {
-    for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-            uint8_t *p = &rgb[(size_t(y) * size_t(w) + size_t(x)) * 3];
-            p[0] = c.r;
-            p[1] = c.g;
-            p[2] = c.b;
-        }
-}
-
-namespace {
-
-// Where withLegend puts each entry below an image W wide: (x, row) per entry, and the font scale,
+// Where the legend puts each entry below an image W wide: (x, row) per entry, and the font scale,
 // margin, row height, swatch side and the strip's height.
 struct LegendPlaces {
     int s = 1, margin = 0, rowH = 0, swatch = 0, strip = 0;
@@ -53,16 +40,10 @@ LegendPlaces placeLegend(int W, const std::vector<LegendEntry> &entries) {
 
 std::vector<uint8_t> withLegend(const std::vector<uint8_t> &image, int W, int H, const std::vector<LegendEntry> &entries,
                                 int *canvasH) {
-    const LegendPlaces L = placeLegend(W, entries);
-    *canvasH = H + L.strip;
-    std::vector<uint8_t> rgb(size_t(W) * size_t(*canvasH) * 3);
-    std::copy(image.begin(), image.end(), rgb.begin());
-    fillRect(rgb, W, 0, H, W, *canvasH, kStrip);
-    for (size_t i = 0; i < entries.size(); ++i) {
-        const int ex = L.at[i].first, ey = H + L.at[i].second * L.rowH + L.margin;
-        fillRect(rgb, W, ex, ey, std::min(ex + L.swatch, W), std::min(ey + L.swatch, *canvasH), entries[i].color);
-        drawText(rgb.data(), W, *canvasH, ex + L.swatch + 2 * L.s, ey, entries[i].label, {kText.r, kText.g, kText.b}, L.s);
-    }
+    const PaletteImage canvas = legendCanvas(W, H, entries);
+    *canvasH = canvas.height;
+    std::vector<uint8_t> rgb = canvas.rgb();
+    std::copy(image.begin(), image.begin() + ptrdiff_t(std::min(image.size(), size_t(W) * size_t(H) * 3)), rgb.begin());
     return rgb;
 }
 

@@ -26,7 +26,4 @@ std::vector<uint8_t> withLegend(const std::vector<uint8_t> &image, int W, int H,
 // rows [0, H) the strip's background for the caller to draw the image over.
 PaletteImage legendCanvas(int W, int H, const std::vector<LegendEntry> &entries);
 
-// Fills the rectangle [x0, x1) x [y0, y1) of an RGB8 image of width w.
-void fillRect(std::vector<uint8_t> &rgb, int w, int x0, int y0, int x1, int y1, Rgb8 c);
-
 }  // namespace va
