@@ -551,7 +551,9 @@ void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &
         for (size_t p = 0; p < N; ++p) {
             if (two.screen1[p] == kNoFragment) continue;
             const double d1 = two.depth1[p];
-            if (two.screen2[p] != kNoFragment) {
+            // n2 < r.twoSurfacePixels always holds here (the caller counted the second surfaces,
+            // and one is kept only after a first); the test keeps the writes inside the lists.
+            if (two.screen2[p] != kNoFragment && n2 < r.twoSurfacePixels) {
                 px[n2] = uint32_t(p);
                 a[n2] = d1;
                 b[n2] = two.depth2[p];
