@@ -51,7 +51,7 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
     if (audit.unaccountedPixels) legend.push_back({kCullUnaccounted, "unaccounted"});
     PaletteImage img = legendCanvas(W, H, legend);
     // Each pixel's color from its fate, and a drawn pixel's from its depth gray, through tables.
-    uint16_t fateCode[256], drawnCode[256];
+    uint16_t fateCode[256], drawnCode[256];  // by fate; by depth gray
     for (int f = 0; f < 256; ++f) {
         Rgb8 c{0, 0, 0};
         if (f == kFateUnaccounted) c = kCullUnaccounted;
@@ -59,9 +59,8 @@ bool writeCullingImage(const ReferenceVisibility &ref, const CullAudit &audit, c
         else if (f == kFateBeyondFarPlane) c = kCullBeyondFarPlane;
         else if (f >= kFateCulledFirst) c = cullStageColor(size_t(f - kFateCulledFirst));
         fateCode[f] = img.codeOf(c);
-        const int g = f;
-        drawnCode[g] = img.codeOf({uint8_t(g * kCullDrawnTint.r / 255), uint8_t(g * kCullDrawnTint.g / 255),
-                                   uint8_t(g * kCullDrawnTint.b / 255)});
+        drawnCode[f] = img.codeOf({uint8_t(f * kCullDrawnTint.r / 255), uint8_t(f * kCullDrawnTint.g / 255),
+                                   uint8_t(f * kCullDrawnTint.b / 255)});  // f as the depth gray
     }
     const PixelGrays gray(ref.depth, grays);
     for (size_t i = 0; i < n; ++i) {  // the canvas is W wide: pixel i of the image is code i

@@ -103,21 +103,18 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     }
 
     // 3. Outlines and ids of the listed hotspots, largest (id 1) drawn first; only inside the view
-    // (the canvas' rows above the strip and its first W columns).
-    auto setInView = [&](int x, int y, uint16_t c) {
-        if (x >= 0 && y >= 0 && x < W && y < H) img.code[size_t(y) * cw + size_t(x)] = c;
-    };
+    // (the canvas' rows above the strip and its first W columns: the loops stay within them).
     for (const ZFightHotspot &h : zf.hotspots) {
         const Rgb8 col = zfightHotspotColor(h.id);
         const uint16_t c = img.codeOf(col);
         const int x0 = h.minX - 2, y0 = h.minY - 2, x1 = h.maxX + 2, y1 = h.maxY + 2;
         for (int xx = std::max(x0, 0); xx <= std::min(x1, W - 1); ++xx) {
-            if (y0 >= 0) setInView(xx, y0, c);
-            if (y1 < H) setInView(xx, y1, c);
+            if (y0 >= 0) img.set(xx, y0, c);
+            if (y1 < H) img.set(xx, y1, c);
         }
         for (int y = std::max(y0, 0); y <= std::min(y1, H - 1); ++y) {
-            if (x0 >= 0 && x0 < W) setInView(x0, y, c);
-            if (x1 >= 0 && x1 < W) setInView(x1, y, c);
+            if (x0 >= 0 && x0 < W) img.set(x0, y, c);
+            if (x1 >= 0 && x1 < W) img.set(x1, y, c);
         }
         const std::string label = std::to_string(h.id);
         const int ly = y0 - 1 - textHeight(s) >= 0 ? y0 - 1 - textHeight(s) : std::min(y1 + 2, H - textHeight(s));
