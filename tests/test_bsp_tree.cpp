@@ -147,6 +147,62 @@ TEST(BspTree, Orient3dAgreesWithCgal) {
     EXPECT_GT(decided, 5000);  // many exact zeros: the stages before CGAL were exercised
 }
 
+// orient3d's scaled-integer stage at its bounds: coordinates that are integer multiples of one power
+// of two 2^e (e from 2^-40 to 2^20) whose integers reach 2^57 .. 2^63 (the stage takes those below
+// 2^61, the others go on to the later stages), one corner an odd multiple so that 2^e is the
+// common scale, and the fourth point on the plane up to rounding (the filter cannot tell), or
+// moved by a few of its ulps, against CGAL's exact predicate alone.
+TEST(BspTree, Orient3dScaledIntegersAgreeWithCgalAtTheirBounds) {
+    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+    uint64_t state = 13;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    };
+    int zeros = 0, nearPlane = 0;
+    for (int i = 0; i < 30000; ++i) {
+        const int e = int(next() * 60) - 40, bits = 57 + i % 7;
+        auto coord = [&] { return std::ldexp(std::round((next() * 2 - 1) * std::ldexp(1.0, 52)), bits - 52 + e); };
+        Vec3 a{coord(), coord(), coord()}, b{coord(), coord(), coord()}, c{coord(), coord(), coord()};
+        a[i % 3] = std::ldexp(double(2 * int(next() * 1000) + 1), e);  // an odd multiple of 2^e
+        Vec3 d = a + (b - a) * (next() * 2 - 1) + (c - a) * (next() * 2 - 1);
+        if (i % 5 == 0) d = (a + b) * 0.5;  // on an edge
+        if (i % 4 == 1) d[i % 3] = std::nextafter(d[i % 3], next() < 0.5 ? -INFINITY : INFINITY);
+        const CGAL::Orientation o = CGAL::orientation(K::Point_3(a.x, a.y, a.z), K::Point_3(b.x, b.y, b.z),
+                                                      K::Point_3(c.x, c.y, c.z), K::Point_3(d.x, d.y, d.z));
+        const int want = o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+        ASSERT_EQ(orient3d(a, b, c, d), want) << i;
+        ASSERT_EQ(PlaneSide(a, b, c)(d), want) << i;
+        zeros += want == 0;
+        // Within the filter's bound of the plane (7 roundings of the permanent): the filter
+        // cannot tell these, an exact stage does.
+        const Vec3 r1 = b - a, r2 = c - a, r3 = d - a;
+        const double permanent = std::fabs(r1.x) * (std::fabs(r2.y * r3.z) + std::fabs(r2.z * r3.y)) +
+                                 std::fabs(r1.y) * (std::fabs(r2.z * r3.x) + std::fabs(r2.x * r3.z)) +
+                                 std::fabs(r1.z) * (std::fabs(r2.x * r3.y) + std::fabs(r2.y * r3.x));
+        nearPlane += want != 0 && std::fabs(dot(r1, cross(r2, r3))) <= 7 * 0x1p-53 * permanent;
+    }
+    EXPECT_GT(zeros, 50);
+    EXPECT_GT(nearPlane, 10000);
+    // A determinant of +-1 (in units of the scale) under a permanent near 2^80: rows r1 and r2 whose
+    // x, y parts are consecutive Fibonacci numbers (F(n+1) F(n-1) - F(n)^2 = (-1)^n, so
+    // (r1 x r2).z = +-1) and r3 = r1 + r2 + (0, 0, +-1 or 0), at large integer coordinates.
+    for (int i = 0; i < 1000; ++i) {
+        const int n = 30 + i % 10;
+        double f0 = 0, f1 = 1;  // F(k), F(k + 1)
+        for (int k = 0; k < n - 1; ++k) std::tie(f0, f1) = std::pair{f1, f0 + f1};  // F(n - 1), F(n)
+        const double scale = std::ldexp(1.0, int(next() * 40) - 20);
+        const Vec3 a = Vec3{std::round(next() * 0x1p30), std::round(next() * 0x1p30), std::round(next() * 0x1p30)} * scale;
+        const Vec3 r1 = Vec3{f0 + f1, f1, std::round(next() * 0x1p28)} * scale;
+        const Vec3 r2 = Vec3{f1, f0, std::round(next() * 0x1p28)} * scale;
+        const int cross = n % 2 ? -1 : 1;  // (r1 x r2).z / scale^2 = F(n+1) F(n-1) - F(n)^2
+        const int off = i % 3 - 1;
+        const Vec3 d = a + r1 + r2 + Vec3{0, 0, off * scale};
+        ASSERT_EQ(orient3d(a, a + r1, a + r2, d), off * cross) << i;
+        ASSERT_EQ(PlaneSide(a, a + r1, a + r2)(d), off * cross) << i;
+    }
+}
+
 // PlaneSide gives orient3d's sign for every point: on axis-aligned planes (its comparison path:
 // level brushes) and general ones (its filter, then orient3d), at wide magnitudes, with points on,
 // one ulp off and far from the plane, and for degenerate (collinear) triangles.

@@ -34,6 +34,15 @@ struct Builder {
     BspTree &tree;
     std::vector<uint32_t> vertexTag;  // per tree vertex: the node whose split made it, or kInputVertex
     uint64_t predicates = 0;
+    // chooseSplitter's sampled pieces: their points as arrays of coordinates, and per piece its
+    // source, whether it was split, and where its points start (first[j + 1]: where they end).
+    struct SampleSoA {
+        std::vector<double> x, y, z;
+        std::vector<uint32_t> source, first;
+        std::vector<uint8_t> split;
+        void clear() { x.clear(), y.clear(), z.clear(), source.clear(), first.clear(), split.clear(); }
+        void add(Vec3 p) { x.push_back(p.x), y.push_back(p.y), z.push_back(p.z); }
+    } sample;
 
     Vec3 sourceVertex(uint32_t s, int i) const { return scene.positions[scene.indices[3 * size_t(s) + i]]; }
 
@@ -143,24 +152,64 @@ struct Builder {
         const size_t k = settings.candidates == 0 ? n : std::min<size_t>(settings.candidates, n);
         if (k <= 1) return list[0];
         const size_t m = settings.scoreSample == 0 ? n : std::min<size_t>(settings.scoreSample, n);
+        // The sampled pieces' points, gathered once for every candidate: their vertices, and for a
+        // split piece first its source's three input vertices (classify's coplanarity check). No
+        // vertex was made by this node's split yet, so classify would test every one of them.
+        SampleSoA &g = sample;
+        g.clear();
+        for (size_t j = 0; j < m; ++j) {
+            const BspPiece &pc = tree.pieces[list[(j * n) / m]];
+            g.source.push_back(pc.source);
+            g.split.push_back(pc.constraintCount != 0);
+            g.first.push_back(uint32_t(g.x.size()));
+            if (pc.constraintCount)
+                for (int i = 0; i < 3; ++i) g.add(sourceVertex(pc.source, i));
+            for (uint32_t i = 0; i < pc.vertexCount; ++i) g.add(tree.vertices[pc.firstVertex + i]);
+        }
+        g.first.push_back(uint32_t(g.x.size()));
         // The candidates are scored independently (in parallel when there is enough work: the
         // nodes near the root), then the first with the lowest score wins, as in a serial loop.
         std::vector<double> score(k);
         std::vector<uint64_t> count(k, 0);
         auto scoreCandidate = [&](size_t c) {
             const uint32_t cand = list[(c * n) / k];
+            const uint32_t candSource = tree.pieces[cand].source;
             Vec3 abc[3];
-            source3(tree.pieces[cand].source, abc);
+            source3(candSource, abc);
             const PlaneSide plane(abc[0], abc[1], abc[2]);
-            uint64_t front = 0, back = 0, splits = 0;
+            thread_local std::vector<int32_t> signs;
+            signs.resize(g.x.size());
+            plane.filterSigns(g.x.data(), g.y.data(), g.z.data(), g.x.size(), signs.data());
+            auto sideOf = [&](uint32_t i) {
+                if (signs[i] == 2) signs[i] = plane.undecided({g.x[i], g.y[i], g.z[i]});
+                return signs[i];
+            };
+            uint64_t front = 0, back = 0, splits = 0, predicates = 0;
             for (size_t j = 0; j < m; ++j) {
-                switch (classify(list[(j * n) / m], tree.pieces[cand].source, node, plane, nullptr, count[c])) {
-                    case kFront: ++front; break;
-                    case kBack: ++back; break;
-                    case kStraddle: ++splits; ++front; ++back; break;
-                    default: break;
+                // classify(), on the gathered points.
+                if (g.source[j] == candSource) continue;  // coplanar
+                uint32_t i = g.first[j];
+                if (g.split[j]) {
+                    bool allOn = true;
+                    for (int v = 0; v < 3 && allOn; ++v) {
+                        ++predicates;
+                        allOn = sideOf(i + uint32_t(v)) == 0;
+                    }
+                    if (allOn) continue;  // coplanar
+                    i += 3;
                 }
+                bool f = false, b = false;
+                for (; i < g.first[j + 1]; ++i) {
+                    const int sd = sideOf(i);
+                    f |= sd > 0;
+                    b |= sd < 0;
+                }
+                predicates += g.first[j + 1] - g.first[j] - (g.split[j] ? 3 : 0);
+                front += f;
+                back += b;
+                splits += f && b;
             }
+            count[c] = predicates;
             score[c] = settings.splitWeight * double(splits) + settings.balanceWeight * std::fabs(double(front) - double(back));
         };
         if (k * m >= kParallelScoring)
@@ -267,26 +316,64 @@ int lowestBitExponent(double v) {
     return k - 53 + std::countr_zero(bits);
 }
 
-}  // namespace
+// Sign of det[b - a, c - a, d - a] when the twelve coordinates are integer multiples of one power
+// of two 2^e below 2^61 in magnitude -- as a level's grid coordinates together with the points its
+// BSP splits construct near them are -- or 2 when they are not (or one is subnormal or not finite).
+// The coordinates' integers X (exact: a power-of-two scale) differ by less than 2^62, so the nine
+// differences are exact in 64 bits, the three 2x2 minors (below 2^125) in 128, and each row entry
+// times its minor is summed in 192 bits as (high 128) * 2^64 + (low 64): the determinant of the
+// integers, whose sign is the sign sought (it is 2^-3e times the real one).
+int orientScaledIntegers(const double c[12]) {
+    int lo = INT32_MAX, hi = INT32_MIN;
+    int exponent[12];
+    uint64_t significand[12];
+    for (int i = 0; i < 12; ++i) {
+        significand[i] = 0;
+        if (c[i] == 0) continue;
+        const uint64_t bits = std::bit_cast<uint64_t>(c[i]);
+        const int biased = int((bits >> 52) & 0x7FF);
+        if (biased == 0 || biased == 0x7FF) return 2;
+        significand[i] = (bits & ((uint64_t(1) << 52) - 1)) | (uint64_t(1) << 52);
+        exponent[i] = biased - 1075;  // c = +-significand * 2^exponent
+        lo = std::min(lo, exponent[i] + std::countr_zero(significand[i]));
+        hi = std::max(hi, exponent[i] + 52);
+    }
+    if (lo == INT32_MAX) return 0;  // all twelve zero
+    if (hi - lo > 60) return 2;     // some |X| would reach 2^61
+    int64_t X[12];
+    for (int i = 0; i < 12; ++i) {
+        if (!significand[i]) {
+            X[i] = 0;
+            continue;
+        }
+        const int shift = exponent[i] - lo;  // >= -(trailing zeros): a right shift drops only zeros
+        const uint64_t m = shift >= 0 ? significand[i] << shift : significand[i] >> -shift;
+        X[i] = c[i] < 0 ? -int64_t(m) : int64_t(m);
+    }
+    const int64_t r[9] = {X[3] - X[0], X[4] - X[1], X[5] - X[2], X[6] - X[0], X[7] - X[1],
+                          X[8] - X[2], X[9] - X[0], X[10] - X[1], X[11] - X[2]};
+    using I128 = __int128;
+    const I128 minor[3] = {I128(r[4]) * r[8] - I128(r[5]) * r[7], I128(r[5]) * r[6] - I128(r[3]) * r[8],
+                           I128(r[3]) * r[7] - I128(r[4]) * r[6]};
+    I128 high = 0;             // |high| < 2^126
+    unsigned __int128 low = 0;  // three values below 2^64
+    for (int k = 0; k < 3; ++k) {
+        const int64_t mh = int64_t(minor[k] >> 64);  // minor = mh * 2^64 + ml, |mh| <= 2^61
+        const uint64_t ml = uint64_t(minor[k]);
+        const I128 t = I128(r[k]) * I128(ml);         // below 2^126 in magnitude
+        high += I128(r[k]) * mh + (t >> 64);
+        low += uint64_t(t);
+    }
+    high += I128(low >> 64);
+    if (high != 0) return high > 0 ? 1 : -1;
+    return uint64_t(low) != 0 ? 1 : 0;
+}
 
-int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-    // Static filter first (Shewchuk's orient3d, stage A): with the three rows as rounded
-    // differences r1 = b - a, r2 = c - a, r3 = d - a, the double determinant r1 . (r2 x r3) is
-    // within (7 + 56 eps) eps * permanent of the exact one, eps = 2^-53, permanent = the same
-    // expansion with every product in absolute value (the bound covers the rounded differences).
-    // Only when the sign is not certain does CGAL's filtered exact predicate decide.
+// orient3d after its filter (or PlaneSide's, the same expansion along another row) could not tell.
+int orient3dExact(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     const double r1x = b.x - a.x, r1y = b.y - a.y, r1z = b.z - a.z;
     const double r2x = c.x - a.x, r2y = c.y - a.y, r2z = c.z - a.z;
     const double r3x = d.x - a.x, r3y = d.y - a.y, r3z = d.z - a.z;
-    const double m1 = r2y * r3z, m2 = r2z * r3y, m3 = r2z * r3x, m4 = r2x * r3z, m5 = r2x * r3y, m6 = r2y * r3x;
-    const double det = r1x * (m1 - m2) + r1y * (m3 - m4) + r1z * (m5 - m6);
-    const double permanent = std::fabs(r1x) * (std::fabs(m1) + std::fabs(m2)) +
-                             std::fabs(r1y) * (std::fabs(m3) + std::fabs(m4)) +
-                             std::fabs(r1z) * (std::fabs(m5) + std::fabs(m6));
-    constexpr double eps = 0x1p-53;
-    const double bound = (7.0 + 56.0 * eps) * eps * permanent;
-    if (det > bound) return 1;
-    if (det < -bound) return -1;
     // Exact zeros the filter cannot see (its bound is 0 or the terms cancel), common in levels:
     // d equal to a corner, and every term of the expansion holding a factor that is exactly zero
     // (a difference of doubles is 0 only when they are equal, so the exact difference is 0 too),
@@ -295,6 +382,11 @@ int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     const bool z1 = r2y == 0 || r3z == 0, z2 = r2z == 0 || r3y == 0, z3 = r2z == 0 || r3x == 0,
                z4 = r2x == 0 || r3z == 0, z5 = r2x == 0 || r3y == 0, z6 = r2y == 0 || r3x == 0;
     if ((r1x == 0 || (z1 && z2)) && (r1y == 0 || (z3 && z4)) && (r1z == 0 || (z5 && z6))) return 0;
+    {
+        const double coords[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+        const int sign = orientScaledIntegers(coords);
+        if (sign != 2) return sign;
+    }
     // Integer stage: when the nine differences are exact and are integer multiples of one power of
     // two 2^e with quotients below 2^40 in magnitude -- as level coordinates on a grid, or floats of
     // similar size, are -- the determinant of the quotients is exact in 128-bit integers (products
@@ -329,6 +421,29 @@ int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
 }
 
+}  // namespace
+
+int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    // Static filter first (Shewchuk's orient3d, stage A): with the three rows as rounded
+    // differences r1 = b - a, r2 = c - a, r3 = d - a, the double determinant r1 . (r2 x r3) is
+    // within (7 + 56 eps) eps * permanent of the exact one, eps = 2^-53, permanent = the same
+    // expansion with every product in absolute value (the bound covers the rounded differences).
+    // Only when the sign is not certain do the exact stages (orient3dExact) decide.
+    const double r1x = b.x - a.x, r1y = b.y - a.y, r1z = b.z - a.z;
+    const double r2x = c.x - a.x, r2y = c.y - a.y, r2z = c.z - a.z;
+    const double r3x = d.x - a.x, r3y = d.y - a.y, r3z = d.z - a.z;
+    const double m1 = r2y * r3z, m2 = r2z * r3y, m3 = r2z * r3x, m4 = r2x * r3z, m5 = r2x * r3y, m6 = r2y * r3x;
+    const double det = r1x * (m1 - m2) + r1y * (m3 - m4) + r1z * (m5 - m6);
+    const double permanent = std::fabs(r1x) * (std::fabs(m1) + std::fabs(m2)) +
+                             std::fabs(r1y) * (std::fabs(m3) + std::fabs(m4)) +
+                             std::fabs(r1z) * (std::fabs(m5) + std::fabs(m6));
+    constexpr double eps = 0x1p-53;
+    const double bound = (7.0 + 56.0 * eps) * eps * permanent;
+    if (det > bound) return 1;
+    if (det < -bound) return -1;
+    return orient3dExact(a, b, c, d);
+}
+
 PlaneSide::PlaneSide(Vec3 a, Vec3 b, Vec3 c) : a_(a), b_(b), c_(c) {
     for (int k = 0; k < 3 && axis_ < 0; ++k)
         if (a[k] == b[k] && a[k] == c[k]) axis_ = k;
@@ -350,22 +465,43 @@ PlaneSide::PlaneSide(Vec3 a, Vec3 b, Vec3 c) : a_(a), b_(b), c_(c) {
     m_[0] = std::fabs(p1) + std::fabs(p2), m_[1] = std::fabs(p3) + std::fabs(p4), m_[2] = std::fabs(p5) + std::fabs(p6);
 }
 
-int PlaneSide::operator()(Vec3 d) const {
-    if (axis_ >= 0) return axisSign_ * ((d[axis_] > a_[axis_]) - (d[axis_] < a_[axis_]));
-    const double r3x = d.x - a_.x, r3y = d.y - a_.y, r3z = d.z - a_.z;
-    const double det = r3x * n_[0] + r3y * n_[1] + r3z * n_[2];
-    const double permanent = std::fabs(r3x) * m_[0] + std::fabs(r3y) * m_[1] + std::fabs(r3z) * m_[2];
+int PlaneSide::undecided(Vec3 d) const { return orient3dExact(a_, b_, c_, d); }
+
+namespace {
+
+// PlaneSide::filterSigns's loops, built twice (AVX2 and the baseline; the first call picks by the
+// CPU): the same operations per point either way (no FMA: -ffp-contract=off).
+__attribute__((target_clones("avx2", "default")))
+void filterSignsLoop(const double *x, const double *y, const double *z, size_t n, int32_t *out, int axis, int axisSign,
+                     Vec3 a, const double *nv, const double *mv) {
+    if (axis >= 0) {
+        const double *c = axis == 0 ? x : (axis == 1 ? y : z);
+        const double k = a[axis];
+        for (size_t i = 0; i < n; ++i) out[i] = axisSign * (int32_t(c[i] > k) - int32_t(c[i] < k));
+        return;
+    }
+    // PlaneSide::operator()'s filter, the same operations in the same order per point.
+    const double ax = a.x, ay = a.y, az = a.z, n0 = nv[0], n1 = nv[1], n2 = nv[2], m0 = mv[0], m1 = mv[1], m2 = mv[2];
     constexpr double eps = 0x1p-53;
-    const double bound = (7.0 + 56.0 * eps) * eps * permanent;
-    if (det > bound) return 1;
-    if (det < -bound) return -1;
-    return orient3d(a_, b_, c_, d);
+    for (size_t i = 0; i < n; ++i) {
+        const double r3x = x[i] - ax, r3y = y[i] - ay, r3z = z[i] - az;
+        const double det = r3x * n0 + r3y * n1 + r3z * n2;
+        const double permanent = std::fabs(r3x) * m0 + std::fabs(r3y) * m1 + std::fabs(r3z) * m2;
+        const double bound = (7.0 + 56.0 * eps) * eps * permanent;
+        out[i] = det > bound ? 1 : (det < -bound ? -1 : 2);
+    }
+}
+
+}  // namespace
+
+void PlaneSide::filterSigns(const double *x, const double *y, const double *z, size_t n, int32_t *out) const {
+    filterSignsLoop(x, y, z, n, out, axis_, axisSign_, a_, n_, m_);
 }
 
 BspTree buildBspTree(const Scene &scene, const std::vector<uint32_t> &triangles, const BspSettings &settings) {
     const Stopwatch t0;
     BspTree tree;
-    Builder b{scene, settings, tree, {}, 0};
+    Builder b{scene, settings, tree, {}, 0, {}};
     std::vector<uint32_t> list;
     list.reserve(triangles.size());
     for (uint32_t t : triangles) {
