@@ -22,6 +22,23 @@ namespace {
 
 using testing_util::looseTriangles;
 
+// Reproducible uniform doubles in [0, 1): a 64-bit LCG's high 53 bits.
+struct Uniform01 {
+    uint64_t state;
+    double operator()() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    }
+};
+
+// CGAL's exact orientation predicate alone (Epick), as orient3d's sign.
+int cgalOrient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+    const CGAL::Orientation o = CGAL::orientation(K::Point_3(a.x, a.y, a.z), K::Point_3(b.x, b.y, b.z),
+                                                  K::Point_3(c.x, c.y, c.z), K::Point_3(d.x, d.y, d.z));
+    return o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+}
+
 // Three thin triangles ("sticks") around the z axis, each rotated 120 degrees from the last, each
 // rising along its length (z = 0.3 x in its own frame). The sticks' lines are the sides of an
 // equilateral triangle of inradius 1, so stick k's high end crosses over stick k+1's low end:
@@ -89,11 +106,8 @@ TEST(BspTree, Orient3dSignAndExactness) {
     // The exact zeros decided before CGAL (a corner repeated; four points on one axis-aligned
     // plane), against the truth, and one ulp off the plane the sign is still exact: random
     // level-sized coordinates on planes x, y or z = const.
-    uint64_t state = 42;
-    auto next = [&] {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return double(state >> 11) * 0x1p-53 * 2e4 - 1e4;
-    };
+    Uniform01 uniform{42};
+    auto next = [&] { return uniform() * 2e4 - 1e4; };
     for (int i = 0; i < 2000; ++i) {
         const int axis = i % 3;
         const double k = next();
@@ -119,12 +133,7 @@ TEST(BspTree, Orient3dSignAndExactness) {
 // alone, on inputs that reach every stage: points on random planes through grid and float
 // coordinates (coplanar up to rounding), snapped to grids of several sizes, and exact copies.
 TEST(BspTree, Orient3dAgreesWithCgal) {
-    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-    uint64_t state = 7;
-    auto next = [&] {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return double(state >> 11) * 0x1p-53;
-    };
+    Uniform01 next{7};
     int decided = 0;
     for (int i = 0; i < 20000; ++i) {
         const double grid = std::ldexp(1.0, int(next() * 12) - 6);  // 1/64 .. 32
@@ -138,9 +147,7 @@ TEST(BspTree, Orient3dAgreesWithCgal) {
         Vec3 d = o + u * s + w * t;  // on the plane up to rounding
         d = {snap(d.x), snap(d.y), snap(d.z)};
         if (i % 3 == 0) d = i % 2 ? b : c;
-        const CGAL::Orientation e = CGAL::orientation(K::Point_3(a.x, a.y, a.z), K::Point_3(b.x, b.y, b.z),
-                                                      K::Point_3(c.x, c.y, c.z), K::Point_3(d.x, d.y, d.z));
-        const int want = e == CGAL::POSITIVE ? 1 : (e == CGAL::NEGATIVE ? -1 : 0);
+        const int want = cgalOrient3d(a, b, c, d);
         ASSERT_EQ(orient3d(a, b, c, d), want) << i;
         decided += want == 0;
     }
@@ -153,12 +160,7 @@ TEST(BspTree, Orient3dAgreesWithCgal) {
 // common scale, and the fourth point on the plane up to rounding (the filter cannot tell), or
 // moved by a few of its ulps, against CGAL's exact predicate alone.
 TEST(BspTree, Orient3dScaledIntegersAgreeWithCgalAtTheirBounds) {
-    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-    uint64_t state = 13;
-    auto next = [&] {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return double(state >> 11) * 0x1p-53;
-    };
+    Uniform01 next{13};
     int zeros = 0, nearPlane = 0;
     for (int i = 0; i < 30000; ++i) {
         const int e = int(next() * 60) - 40, bits = 57 + i % 7;
@@ -168,9 +170,7 @@ TEST(BspTree, Orient3dScaledIntegersAgreeWithCgalAtTheirBounds) {
         Vec3 d = a + (b - a) * (next() * 2 - 1) + (c - a) * (next() * 2 - 1);
         if (i % 5 == 0) d = (a + b) * 0.5;  // on an edge
         if (i % 4 == 1) d[i % 3] = std::nextafter(d[i % 3], next() < 0.5 ? -INFINITY : INFINITY);
-        const CGAL::Orientation o = CGAL::orientation(K::Point_3(a.x, a.y, a.z), K::Point_3(b.x, b.y, b.z),
-                                                      K::Point_3(c.x, c.y, c.z), K::Point_3(d.x, d.y, d.z));
-        const int want = o == CGAL::POSITIVE ? 1 : (o == CGAL::NEGATIVE ? -1 : 0);
+        const int want = cgalOrient3d(a, b, c, d);
         ASSERT_EQ(orient3d(a, b, c, d), want) << i;
         ASSERT_EQ(PlaneSide(a, b, c)(d), want) << i;
         zeros += want == 0;
@@ -207,11 +207,7 @@ TEST(BspTree, Orient3dScaledIntegersAgreeWithCgalAtTheirBounds) {
 // level brushes) and general ones (its filter, then orient3d), at wide magnitudes, with points on,
 // one ulp off and far from the plane, and for degenerate (collinear) triangles.
 TEST(BspTree, PlaneSideAgreesWithOrient3d) {
-    uint64_t state = 11;
-    auto next = [&] {
-        state = state * 6364136223846793005ull + 1442695040888963407ull;
-        return double(state >> 11) * 0x1p-53;
-    };
+    Uniform01 next{11};
     int axisPlanes = 0, zeros = 0, offByUlp = 0;
     for (int i = 0; i < 20000; ++i) {
         const double scale = std::ldexp(1.0, int(next() * 60) - 30);  // 2^-30 .. 2^30
