@@ -4,6 +4,7 @@
 #include "render/recycle.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -285,25 +286,39 @@ struct FilterContext {
 };
 void primaryFilter(const RTCFilterFunctionNArguments *args) {
     FilterContext &fc = *reinterpret_cast<FilterContext *>(args->context);
-    for (unsigned i = 0; i < args->N; ++i) {
-        if (args->valid[i] != -1) continue;
+    int *valid = args->valid;
+    auto lane = [&](unsigned i) {
         const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
         if (fc.reject && fc.reject[prim]) {
-            args->valid[i] = 0;
-            continue;
+            valid[i] = 0;
+            return;
         }
         if (fc.primToSource) {
             const unsigned lane = RTCRayN_id(args->ray, args->N, i) & 15u;
             const float t = RTCRayN_tfar(args->ray, args->N, i);
             const uint32_t src = fc.primToSource[prim];
             if (t == fc.bestT[lane] && src > fc.bestSource[lane]) {
-                args->valid[i] = 0;
-                continue;
+                valid[i] = 0;
+                return;
             }
             fc.bestT[lane] = t;
             fc.bestSource[lane] = src;
         }
+    };
+    if (args->N == 16) {
+        // A packet's call: a few of its 16 lanes are valid (3.4 on average on the benchmark scene),
+        // so the valid ones are found as a bit mask and visited in ascending order, as the loop
+        // over every lane below visits them, without a branch per lane.
+        const __m128i on = _mm_set1_epi32(-1);
+        const __m128i *v = reinterpret_cast<const __m128i *>(valid);
+        const __m128i lo = _mm_packs_epi32(_mm_cmpeq_epi32(_mm_loadu_si128(v), on), _mm_cmpeq_epi32(_mm_loadu_si128(v + 1), on));
+        const __m128i hi = _mm_packs_epi32(_mm_cmpeq_epi32(_mm_loadu_si128(v + 2), on), _mm_cmpeq_epi32(_mm_loadu_si128(v + 3), on));
+        for (unsigned mask = unsigned(_mm_movemask_epi8(_mm_packs_epi16(lo, hi))); mask; mask &= mask - 1)
+            lane(unsigned(std::countr_zero(mask)));
+        return;
     }
+    for (unsigned i = 0; i < args->N; ++i)
+        if (valid[i] == -1) lane(i);
 }
 
 // One band of castPrimary (kBary: also write barycentrics; kTies: the context's filter tracks ties
