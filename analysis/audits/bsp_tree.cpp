@@ -480,16 +480,7 @@ void filterSignsLoop(const double *x, const double *y, const double *z, size_t n
         for (size_t i = 0; i < n; ++i) out[i] = axisSign * (int32_t(c[i] > k) - int32_t(c[i] < k));
         return;
     }
-    // PlaneSide::operator()'s filter, the same operations in the same order per point.
-    const double ax = a.x, ay = a.y, az = a.z, n0 = nv[0], n1 = nv[1], n2 = nv[2], m0 = mv[0], m1 = mv[1], m2 = mv[2];
-    constexpr double eps = 0x1p-53;
-    for (size_t i = 0; i < n; ++i) {
-        const double r3x = x[i] - ax, r3y = y[i] - ay, r3z = z[i] - az;
-        const double det = r3x * n0 + r3y * n1 + r3z * n2;
-        const double permanent = std::fabs(r3x) * m0 + std::fabs(r3y) * m1 + std::fabs(r3z) * m2;
-        const double bound = (7.0 + 56.0 * eps) * eps * permanent;
-        out[i] = det > bound ? 1 : (det < -bound ? -1 : 2);
-    }
+    for (size_t i = 0; i < n; ++i) out[i] = PlaneSide::filterSign(x[i] - a.x, y[i] - a.y, z[i] - a.z, nv, mv);
 }
 
 }  // namespace

@@ -44,20 +44,24 @@ public:
     // Inline: the BSP build asks this for every vertex of every piece it scores or partitions.
     int operator()(Vec3 d) const {
         if (axis_ >= 0) return axisSign_ * ((d[axis_] > a_[axis_]) - (d[axis_] < a_[axis_]));
-        const double r3x = d.x - a_.x, r3y = d.y - a_.y, r3z = d.z - a_.z;
-        const double det = r3x * n_[0] + r3y * n_[1] + r3z * n_[2];
-        const double permanent = std::fabs(r3x) * m_[0] + std::fabs(r3y) * m_[1] + std::fabs(r3z) * m_[2];
-        constexpr double eps = 0x1p-53;
-        const double bound = (7.0 + 56.0 * eps) * eps * permanent;
-        if (det > bound) return 1;
-        if (det < -bound) return -1;
-        return undecided(d);
+        const int s = filterSign(d.x - a_.x, d.y - a_.y, d.z - a_.z, n_, m_);
+        return s != 2 ? s : undecided(d);
     }
 
     // The filter's sign for each of n points (x[i], y[i], z[i]) into out[i], or 2 where it cannot
     // tell (then operator() decides: undecided()). A loop the compiler vectorizes.
     void filterSigns(const double *x, const double *y, const double *z, size_t n, int32_t *out) const;
     int undecided(Vec3 d) const;  // orient3d's exact stages, for the points the filter cannot tell
+
+    // orient3d's static filter for r3 = d - a against a plane's minors n and their magnitudes m
+    // (below): the sign, or 2 when the double determinant is within its error bound of 0.
+    static int filterSign(double r3x, double r3y, double r3z, const double *n, const double *m) {
+        const double det = r3x * n[0] + r3y * n[1] + r3z * n[2];
+        const double permanent = std::fabs(r3x) * m[0] + std::fabs(r3y) * m[1] + std::fabs(r3z) * m[2];
+        constexpr double eps = 0x1p-53;
+        const double bound = (7.0 + 56.0 * eps) * eps * permanent;
+        return det > bound ? 1 : (det < -bound ? -1 : 2);
+    }
 
 private:
     Vec3 a_, b_, c_;
