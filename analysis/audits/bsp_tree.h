@@ -29,7 +29,8 @@ namespace va {
 
 // Exact sign of det[b - a, c - a, d - a] = ((b - a) x (c - a)) . (d - a): +1 when d lies on the front
 // side of triangle (a, b, c) (where its counter-clockwise normal points), -1 behind, 0 coplanar.
-// CGAL's orientation predicate (Exact_predicates_inexact_constructions_kernel).
+// A static filter, then exact stages (zeros it can see, integer arithmetic when the coordinates lie
+// on one power-of-two grid), then CGAL's orientation predicate (Exact_predicates_inexact_constructions_kernel).
 int orient3d(Vec3 a, Vec3 b, Vec3 c, Vec3 d);
 
 // orient3d(a, b, c, d) for many points d against one plane: the same exact sign, with the work that
