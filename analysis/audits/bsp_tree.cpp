@@ -54,25 +54,26 @@ struct Builder {
         return plane(tree.vertices[v]);
     }
 
-    // Classifies piece p against the plane of source s (node `node`), sides per vertex into `sides`.
-    // `count` adds the predicates evaluated (BspStats::predicateCalls).
-    Side classify(uint32_t p, uint32_t s, uint32_t node, const PlaneSide &plane, int *sides, uint64_t &count) const {
-        const BspPiece &pc = tree.pieces[p];
-        if (pc.source == s) return kCoplanar;
-        // A split piece: coplanarity is decided on its source's input vertices (exact), not on its
-        // constructed ones (rounded).
-        if (pc.constraintCount) {
+    // The classification rule, over sides given by functions (classify asks the plane; the
+    // splitter's scoring reads signs computed ahead): a piece of the plane's own source is coplanar;
+    // a split piece's coplanarity is decided on its source's input vertices (exact), not on its
+    // constructed ones (rounded) -- sourceSide(i), i < 3, each counted in `count`; otherwise the
+    // sides of its vertices, vertexSide(i), i < vertexCount (which count themselves).
+    template <class SourceSide, class VertexSide>
+    static Side classifyBy(bool planeSource, bool split, uint32_t vertexCount, SourceSide &&sourceSide,
+                           VertexSide &&vertexSide, uint64_t &count) {
+        if (planeSource) return kCoplanar;
+        if (split) {
             bool allOn = true;
             for (int i = 0; i < 3 && allOn; ++i) {
                 ++count;
-                allOn = plane(sourceVertex(pc.source, i)) == 0;
+                allOn = sourceSide(i) == 0;
             }
             if (allOn) return kCoplanar;
         }
         bool front = false, back = false;
-        for (uint32_t i = 0; i < pc.vertexCount; ++i) {
-            const int sd = vertexSide(pc.firstVertex + i, node, plane, count);
-            if (sides) sides[i] = sd;
+        for (uint32_t i = 0; i < vertexCount; ++i) {
+            const int sd = vertexSide(i);
             front |= sd > 0;
             back |= sd < 0;
         }
@@ -80,6 +81,16 @@ struct Builder {
         if (front) return kFront;
         if (back) return kBack;
         return kCoplanar;
+    }
+
+    // Classifies piece p against the plane of source s (node `node`), sides per vertex into `sides`.
+    // `count` adds the predicates evaluated (BspStats::predicateCalls).
+    Side classify(uint32_t p, uint32_t s, uint32_t node, const PlaneSide &plane, int *sides, uint64_t &count) const {
+        const BspPiece &pc = tree.pieces[p];
+        return classifyBy(
+            pc.source == s, pc.constraintCount != 0, pc.vertexCount,
+            [&](int i) { return plane(sourceVertex(pc.source, i)); },
+            [&](uint32_t i) { return sides[i] = vertexSide(pc.firstVertex + i, node, plane, count); }, count);
     }
 
     // The point where segment a-b crosses the plane (n, through q), in double, computed from the
@@ -147,13 +158,13 @@ struct Builder {
     // Picks the splitter for a node's pieces: `candidates` pieces evenly spread over the list, each
     // scored over at most `scoreSample` pieces, also evenly spread (all of them for small nodes):
     // the score estimates the split count and the imbalance at a bounded cost per node.
-    uint32_t chooseSplitter(const std::vector<uint32_t> &list, uint32_t node) {
+    uint32_t chooseSplitter(const std::vector<uint32_t> &list) {
         const size_t n = list.size();
         const size_t k = settings.candidates == 0 ? n : std::min<size_t>(settings.candidates, n);
         if (k <= 1) return list[0];
         const size_t m = settings.scoreSample == 0 ? n : std::min<size_t>(settings.scoreSample, n);
         // The sampled pieces' points, gathered once for every candidate: their vertices, and for a
-        // split piece first its source's three input vertices (classify's coplanarity check). No
+        // split piece first its source's three input vertices (classifyBy's coplanarity check). No
         // vertex was made by this node's split yet, so classify would test every one of them.
         SampleSoA &g = sample;
         g.clear();
@@ -186,28 +197,19 @@ struct Builder {
             };
             uint64_t front = 0, back = 0, splits = 0, predicates = 0;
             for (size_t j = 0; j < m; ++j) {
-                // classify(), on the gathered points.
-                if (g.source[j] == candSource) continue;  // coplanar
-                uint32_t i = g.first[j];
-                if (g.split[j]) {
-                    bool allOn = true;
-                    for (int v = 0; v < 3 && allOn; ++v) {
+                const uint32_t first = g.first[j], vertices = g.first[j + 1] - first - (g.split[j] ? 3 : 0);
+                const uint32_t firstVertex = first + (g.split[j] ? 3 : 0);
+                const Side side = classifyBy(
+                    g.source[j] == candSource, g.split[j] != 0, vertices,
+                    [&](int i) { return sideOf(first + uint32_t(i)); },
+                    [&](uint32_t i) {
                         ++predicates;
-                        allOn = sideOf(i + uint32_t(v)) == 0;
-                    }
-                    if (allOn) continue;  // coplanar
-                    i += 3;
-                }
-                bool f = false, b = false;
-                for (; i < g.first[j + 1]; ++i) {
-                    const int sd = sideOf(i);
-                    f |= sd > 0;
-                    b |= sd < 0;
-                }
-                predicates += g.first[j + 1] - g.first[j] - (g.split[j] ? 3 : 0);
-                front += f;
-                back += b;
-                splits += f && b;
+                        return sideOf(firstVertex + i);
+                    },
+                    predicates);
+                front += side == kFront || side == kStraddle;
+                back += side == kBack || side == kStraddle;
+                splits += side == kStraddle;
             }
             count[c] = predicates;
             score[c] = settings.splitWeight * double(splits) + settings.balanceWeight * std::fabs(double(front) - double(back));
@@ -252,7 +254,7 @@ struct Builder {
             }
             tree.stats.depth = std::max(tree.stats.depth, w.depth);
 
-            const uint32_t splitter = chooseSplitter(w.list, node);
+            const uint32_t splitter = chooseSplitter(w.list);
             const uint32_t s = tree.pieces[splitter].source;
             Vec3 abc[3];
             source3(s, abc);
