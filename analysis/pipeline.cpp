@@ -234,6 +234,8 @@ void runZFightAudit(ViewContext &c, const ClipResult &clip) {
     if (std::find(zs.formats.begin(), zs.formats.end(), c.view.depthFormat) == zs.formats.end() &&
         zs.formats.size() < 32)
         zs.formats.push_back(c.view.depthFormat);
+    // The fragments the reference recorded, when it did (the same fragments as a walk of clip.out).
+    if (r.audit.ran()) zs.reference = &r.audit->reference;
     r.zfight = analyzeZFighting(c.scene, c.cam, clip.out, zs);
     r.zfight->ms = t0.ms();
 }
@@ -359,18 +361,19 @@ ViewResult analyzeView(const PreparedScene &ps, const ViewSpec &view, const Came
     runCullingAudit(c, lists, fragmentsPerSource);
     if (c.stopped()) return r;
     runOrderingAudit(c);
-    // The reference's screen triangles and fragments served the ordering audit only: a finished
-    // view keeps neither (estimateMemory's finishedViews).
+    // Detail: triangles drawn against the pixels they show, too small, over-detailed.
+    if (!c.stopped()) {
+        if (s.detail) r.detail = auditDetail(c.scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
+        else r.detail.skip("turned off by --no-detail");
+    }
+    if (!c.stopped()) runZFightAudit(c, clip);
+    // The reference's screen triangles and fragments served the ordering and z-fighting audits
+    // only: a finished view keeps neither (estimateMemory's finishedViews).
     if (r.audit.ran()) {
         recycleFragmentCache(r.audit->reference.fragmentCache);  // their storage, for the next view
         recycleScreenTriangles(r.audit->reference.screen);
     }
-    // Detail: triangles drawn against the pixels they show, too small, over-detailed.
     if (c.stopped()) return r;
-    if (s.detail) r.detail = auditDetail(c.scene, cam, lists.triangles, fragmentsPerSource, r.buffer.id, s.detailSettings);
-    else r.detail.skip("turned off by --no-detail");
-    if (c.stopped()) return r;
-    runZFightAudit(c, clip);
     recycleScreenTriangles(clip.out);  // for the next view's clip
     r.totalMs = tView.ms();
     return r;

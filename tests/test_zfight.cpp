@@ -13,12 +13,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <set>
 
 #include <unistd.h>
 
+#include "analysis/audits/audit.h"
 #include "analysis/stages/backface.h"
 #include "analysis/load/demo.h"
 #include "analysis/stages/frustum.h"
@@ -296,6 +298,59 @@ TEST(ZFightTwoNearest, EqualsTheRuleInTheWalksOrder) {
         EXPECT_TRUE(two.depth2 == rule.d2) << count;
         EXPECT_TRUE(two.screen1 == rule.t1) << count;
         EXPECT_TRUE(two.screen2 == rule.t2) << count;
+    }
+}
+
+// findTwoNearestFromReference gives findTwoNearest's result on every demo view: for the pipeline's
+// screen triangles (each piece also the reference's), for every triangle without the backface
+// stage (single-sided ones seen from behind, which the reference did not record: walked here),
+// with and without the single-sided rule, and for a clip without a guard band (pieces the
+// reference does not have: walked here). Its bands cover the view once, in order.
+TEST(ZFightTwoNearest, FromTheReferenceCacheEqualsTheWalk) {
+    const Scene scene = demoScene();
+    const std::vector<uint8_t> single = singleSidedTriangles(scene);
+    auto same = [](const auto &a, const auto &b) {
+        return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0;
+    };
+    ASSERT_FALSE(scene.views.empty());
+    for (const ViewSpec &view : scene.views) {
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(view.camera, &cam, &err)) << err;
+        const int W = cam.width, H = cam.height;
+        const ReferenceVisibility ref = referenceVisibility(scene, cam, uint64_t(1) << 26);
+        ASSERT_TRUE(ref.fragmentCache.complete()) << view.name;
+        const FrustumResult fr = cullFrustum(scene, buildObjectBvh(scene), cam);
+        TwoNearest bothSides;  // every triangle, no single-sided rule
+        for (int variant = 0; variant < 4; ++variant) {
+            const TriangleLists lists =
+                variant == 0 ? cullBackfaces(scene, fr.visible, cam).kept : allTriangles(scene, fr.visible);
+            ClipSettings cs;
+            if (variant == 3) cs.guardBandPixels = 0;
+            const ClipResult clip =
+                clipTriangles(cam, MeshView{scene.positions.data(), scene.indices.data()}, clipBatches(scene, lists), cs);
+            if (variant == 3) EXPECT_GT(clip.stats.clipped, 0u) << view.name;  // pieces the reference lacks
+            const uint8_t *ss = variant == 2 ? single.data() : nullptr;
+            TwoNearest walked, cached;
+            findTwoNearest(clip.out, W, H, cam.orthographic, ss, walked);
+            size_t next = 0;
+            bool ordered = true;
+            ASSERT_TRUE(findTwoNearestFromReference(scene, ref, clip.out, W, H, cam.orthographic, ss, cached,
+                                                    [&](size_t p0, size_t p1) {
+                                                        ordered = ordered && p0 == next && p1 > p0;
+                                                        next = p1;
+                                                    }));
+            EXPECT_TRUE(ordered) << view.name << " " << variant;
+            EXPECT_EQ(next, size_t(W) * size_t(H)) << view.name << " " << variant;
+            EXPECT_TRUE(same(cached.depth1, walked.depth1)) << view.name << " " << variant;
+            EXPECT_TRUE(same(cached.depth2, walked.depth2)) << view.name << " " << variant;
+            EXPECT_TRUE(same(cached.screen1, walked.screen1)) << view.name << " " << variant;
+            EXPECT_TRUE(same(cached.screen2, walked.screen2)) << view.name << " " << variant;
+            if (variant == 1) bothSides = walked;
+            // Single-sided triangles seen from behind are among the nearest two somewhere: the
+            // fragments the reference did not record matter.
+            if (variant == 2) EXPECT_FALSE(same(walked.screen2, bothSides.screen2)) << view.name;
+        }
     }
 }
 

@@ -22,6 +22,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "analysis/audits/audit.h"
 #include "analysis/audits/depth_audit.h"
 #include "render/depth_format_impl.h"
 #include "render/raster_core.h"
@@ -51,9 +52,42 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Keeps per pixel the two nearest fragments of distinct source triangles. Fragments arrive in
-// submission order, so "strictly nearer" comparisons keep the first drawn in front on equal
-// depths, exactly like the z-buffer's LESS test on equal keys.
+// Keeps fragment (pixel, depth d) of screen triangle t, whose source is `current`, among the
+// pixel's two nearest surfaces. Fragments arrive in submission order, so "strictly nearer"
+// comparisons keep the first drawn in front on equal depths, exactly like the z-buffer's LESS
+// test on equal keys.
+inline void keepTwoNearest(TwoNearest &out, const uint32_t *source, size_t pixel, uint32_t t, uint32_t current,
+                           double d) {
+    double &d1 = out.depth1[pixel], &d2 = out.depth2[pixel];
+    uint32_t &t1 = out.screen1[pixel], &t2 = out.screen2[pixel];
+    // Same surface as a kept one (another clipped piece of the same source triangle): keep the
+    // nearer depth of that surface, never a second slot for it.
+    if (t1 != kNoFragment && source[t1] == current) {
+        if (d < d1) d1 = d, t1 = t;
+        return;
+    }
+    if (t2 != kNoFragment && source[t2] == current) {
+        if (d < d2) {
+            d2 = d, t2 = t;
+            if (d2 < d1) std::swap(d1, d2), std::swap(t1, t2);
+        }
+        return;
+    }
+    if (d < d1) {
+        d2 = d1, t2 = t1;
+        d1 = d, t1 = t;
+    } else if (d < d2) {
+        d2 = d, t2 = t;
+    }
+}
+
+// The z-buffer's single-sided rule (ZBufferSettings::singleSided): a triangle of source s is drawn
+// unless s is single-sided and its projected winding is the back one.
+inline bool drawn(const uint8_t *singleSided, uint32_t s, bool frontWinding) {
+    return !(singleSided && singleSided[s] && !frontWinding);
+}
+
+// The walk's fragments into keepTwoNearest.
 struct TwoNearestSink {
     TwoNearest *out;
     const uint32_t *source;       // ScreenTriangles::source
@@ -62,32 +96,9 @@ struct TwoNearestSink {
 
     bool beginTriangle(size_t t, bool frontWinding) {
         current = source[t];
-        // The z-buffer skips single-sided triangles whose projected winding is the back one.
-        return !(singleSided && singleSided[current] && !frontWinding);
+        return drawn(singleSided, current, frontWinding);
     }
-    void fragment(size_t pixel, size_t t, double d) {
-        double &d1 = out->depth1[pixel], &d2 = out->depth2[pixel];
-        uint32_t &t1 = out->screen1[pixel], &t2 = out->screen2[pixel];
-        // Same surface as a kept one (another clipped piece of the same source triangle): keep the
-        // nearer depth of that surface, never a second slot for it.
-        if (t1 != kNoFragment && source[t1] == current) {
-            if (d < d1) d1 = d, t1 = uint32_t(t);
-            return;
-        }
-        if (t2 != kNoFragment && source[t2] == current) {
-            if (d < d2) {
-                d2 = d, t2 = uint32_t(t);
-                if (d2 < d1) std::swap(d1, d2), std::swap(t1, t2);
-            }
-            return;
-        }
-        if (d < d1) {
-            d2 = d1, t2 = t1;
-            d1 = d, t1 = uint32_t(t);
-        } else if (d < d2) {
-            d2 = d, t2 = uint32_t(t);
-        }
-    }
+    void fragment(size_t pixel, size_t t, double d) { keepTwoNearest(*out, source, pixel, uint32_t(t), current, d); }
     void endTriangle(size_t, uint64_t) {}
 };
 
@@ -112,6 +123,136 @@ void findTwoNearest(const ScreenTriangles &tris, int width, int height, bool ort
     if (n == 0) return;
     TwoNearestSink sink{&r, tris.source.data(), singleSided};
     forEachFragment(tris, r.width, r.height, orthographic, sink);
+}
+
+namespace {
+
+// Records a walk's fragments and each triangle's range, with the z-fighting pass's single-sided
+// rule (TwoNearestSink's).
+struct RecordingSink {
+    FragmentCache *cache;
+    const uint32_t *source;
+    const uint8_t *singleSided;
+    bool beginTriangle(size_t t, bool frontWinding) { return drawn(singleSided, source[t], frontWinding); }
+    void fragment(size_t pixel, size_t, double d) {
+        cache->pixel.push_back(uint32_t(pixel));
+        cache->depth.push_back(d);
+    }
+    void endTriangle(size_t t, uint64_t) { cache->begin[t + 1] = cache->pixel.size(); }
+};
+
+// forEachFragment's frontWinding of a screen triangle: a negative snapped signed area.
+bool frontWinding(const int32_t *v) {
+    const int64_t e1x = int64_t(v[2]) - v[0], e1y = int64_t(v[3]) - v[1];
+    const int64_t e2x = int64_t(v[4]) - v[0], e2y = int64_t(v[5]) - v[1];
+    return e1x * e2y - e1y * e2x < 0;
+}
+
+bool samePlane(const DepthPlane &a, const DepthPlane &b) {
+    return a.valid == b.valid && std::memcmp(&a.a, &b.a, sizeof a.a) == 0 && std::memcmp(&a.b, &b.b, sizeof a.b) == 0 &&
+           std::memcmp(&a.c, &b.c, sizeof a.c) == 0;
+}
+
+}  // namespace
+
+bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref, const ScreenTriangles &tris,
+                                 int width, int height, bool orthographic, const uint8_t *singleSided, TwoNearest &r,
+                                 const std::function<void(size_t, size_t)> &bandDone) {
+    const FragmentCache &cache = ref.fragmentCache;
+    const ScreenTriangles &rs = ref.screen;
+    if (!cache.complete() || cache.begin.size() != rs.size() + 1 || ref.width != width || ref.height != height)
+        return false;
+    r.width = std::max(width, 0);
+    r.height = std::max(height, 0);
+    const size_t W = size_t(r.width), n = W * size_t(r.height);
+    // Every pixel is set band by band below.
+    r.depth1.resize(n);
+    r.depth2.resize(n);
+    r.screen1.resize(n);
+    r.screen2.resize(n);
+    if (n == 0) return true;
+
+    // Per source triangle, its first screen triangle in the reference (a source's pieces are
+    // consecutive there, as in `tris`); the rule the reference's walk drew by.
+    const size_t sources = scene.triangleCount();
+    thread_local std::vector<uint32_t> firstOf;
+    firstOf.assign(sources, UINT32_MAX);
+    for (size_t t = rs.size(); t-- > 0;)
+        if (rs.source[t] < sources) firstOf[rs.source[t]] = uint32_t(t);
+    const std::vector<uint8_t> refSingleSided = singleSidedTriangles(scene);
+
+    // Per screen triangle of `tris` that draws, in submission order, its fragments: a range of the
+    // reference's cache, or (side) of the fragments walked here.
+    struct Run {
+        uint64_t at, end;
+        uint32_t tri;
+        uint32_t side;  // 0: the reference's cache; else 1 + index into `walk`
+    };
+    thread_local std::vector<Run> runs;
+    thread_local ScreenTriangles walk;
+    thread_local FragmentCache walked;
+    runs.clear();
+    walk.clear();
+    uint32_t piece = 0;
+    for (size_t j = 0; j < tris.size(); ++j) {
+        const uint32_t s = tris.source[j];
+        piece = j > 0 && tris.source[j - 1] == s ? piece + 1 : 0;
+        const int32_t *xy = &tris.xy[6 * j];
+        const bool front = frontWinding(xy);
+        if (!drawn(singleSided, s, front)) continue;
+        const DepthPlane &plane = tris.planes[tris.plane[j]];
+        const size_t t = s < sources && firstOf[s] != UINT32_MAX ? size_t(firstOf[s]) + piece : SIZE_MAX;
+        if (t < rs.size() && rs.source[t] == s && std::memcmp(xy, &rs.xy[6 * t], 6 * sizeof(int32_t)) == 0 &&
+            samePlane(plane, rs.planes[rs.plane[t]]) && drawn(refSingleSided.data(), s, front)) {
+            if (cache.begin[t + 1] > cache.begin[t]) runs.push_back({cache.begin[t], cache.begin[t + 1], uint32_t(j), 0});
+            continue;
+        }
+        runs.push_back({0, 0, uint32_t(j), uint32_t(walk.size()) + 1});
+        walk.xy.insert(walk.xy.end(), xy, xy + 6);
+        walk.source.push_back(s);
+        walk.plane.push_back(uint32_t(walk.planes.size()));
+        walk.planes.push_back(plane);
+    }
+    if (walk.size()) {
+        walked.begin.assign(walk.size() + 1, 0);
+        walked.pixel.clear();
+        walked.depth.clear();
+        RecordingSink sink{&walked, walk.source.data(), singleSided};
+        forEachFragment(walk, r.width, r.height, orthographic, sink);
+        // Triangles the walk skipped (no endTriangle) hold no fragment.
+        for (size_t i = 0; i < walk.size(); ++i) walked.begin[i + 1] = std::max(walked.begin[i + 1], walked.begin[i]);
+        for (Run &u : runs)
+            if (u.side) u.at = walked.begin[u.side - 1], u.end = walked.begin[u.side];
+    }
+
+    const size_t bandPixels = kFragmentBandRows * W, bands = (size_t(r.height) + kFragmentBandRows - 1) / kFragmentBandRows;
+    auto pixelsOf = [&](const Run &u) { return u.side ? walked.pixel.data() : cache.pixel.data(); };
+    thread_local std::vector<uint32_t> bandBegin, bandRuns;
+    bandLists(runs.size(), bands, [&](size_t k) {
+        const Run &u = runs[k];
+        if (u.end == u.at) return std::pair<size_t, size_t>{1, 0};
+        const uint32_t *px = pixelsOf(u);
+        return std::pair<size_t, size_t>{px[u.at] / bandPixels, px[u.end - 1] / bandPixels};
+    }, bandBegin, bandRuns);
+    const uint32_t *source = tris.source.data();
+    for (size_t b = 0; b < bands; ++b) {
+        const size_t p0 = b * bandPixels, p1 = std::min(p0 + bandPixels, n);
+        std::fill(r.depth1.begin() + p0, r.depth1.begin() + p1, kInf);
+        std::fill(r.depth2.begin() + p0, r.depth2.begin() + p1, kInf);
+        std::fill(r.screen1.begin() + p0, r.screen1.begin() + p1, kNoFragment);
+        std::fill(r.screen2.begin() + p0, r.screen2.begin() + p1, kNoFragment);
+        for (uint32_t k = bandBegin[b]; k < bandBegin[b + 1]; ++k) {
+            Run &u = runs[bandRuns[k]];
+            const uint32_t *pixelOf = pixelsOf(u);
+            const double *depthOf = u.side ? walked.depth.data() : cache.depth.data();
+            const uint32_t current = source[u.tri];
+            uint64_t f = u.at;
+            for (; f < u.end && pixelOf[f] < p1; ++f) keepTwoNearest(r, source, pixelOf[f], u.tri, current, depthOf[f]);
+            u.at = f;
+        }
+        if (bandDone) bandDone(p0, p1);
+    }
+    return true;
 }
 
 // ---- Triangle pairs: common vertices, shared edge, coplanarity --------------------------------
@@ -523,6 +664,60 @@ uint32_t FightFilter::cell(double d) const {
 
 namespace {
 
+// The pixels with two surfaces as lists (pixel, nearer depth, farther depth), the range of the
+// depths of the pixels with one surface, and the counts; gathered a stretch of pixels at a time
+// (the thread's storage, kept from view to view: only the first n entries are this view's).
+struct TwoSurfaces {
+    std::vector<uint32_t> pixel;
+    std::vector<double> near1, near2;
+    size_t n = 0;
+    double oneMin = kInf, oneMax = -kInf;
+    bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
+    uint64_t covered = 0;       // pixels with a surface
+
+    void clear() {
+        n = 0;
+        oneMin = kInf, oneMax = -kInf;
+        oneUnordered = false;
+        covered = 0;
+    }
+    // Pixels [p0, p1) of `two`, after those gathered before.
+    void gather(const TwoNearest &two, size_t p0, size_t p1) {
+        if (pixel.size() < n + (p1 - p0)) {
+            const size_t size = std::max(n + (p1 - p0), pixel.size() + pixel.size() / 2);
+            pixel.resize(size);
+            near1.resize(size);
+            near2.resize(size);
+        }
+        uint32_t *__restrict px = pixel.data();
+        double *__restrict a = near1.data(), *__restrict b = near2.data();
+        const uint32_t *s1 = two.screen1.data(), *s2 = two.screen2.data();
+        const double *d1s = two.depth1.data(), *d2s = two.depth2.data();
+        size_t m = n;
+        uint64_t cov = 0;
+        double lo = oneMin, hi = oneMax;
+        bool unordered = oneUnordered;
+        for (size_t p = p0; p < p1; ++p) {
+            if (s1[p] == kNoFragment) continue;
+            ++cov;
+            const double d1 = d1s[p];
+            if (s2[p] != kNoFragment) {
+                px[m] = uint32_t(p);
+                a[m] = d1;
+                b[m] = d2s[p];
+                ++m;
+            } else {
+                lo = std::min(lo, d1);
+                hi = std::max(hi, d1);
+                unordered |= d1 != d1;
+            }
+        }
+        n = m;
+        covered += cov;
+        oneMin = lo, oneMax = hi, oneUnordered = unordered;
+    }
+};
+
 // 2. Per format: the fight bit (key(d1) >= key(d2), d1 <= d2: equal stored values or swapped order)
 //    and out-of-range pixels (either surface clamped by the encoder). The two-surface pixels are
 //    gathered once into a compact list; those that cannot fight in any filtered format (2a) are set
@@ -531,40 +726,14 @@ namespace {
 //    clamps d into [minValidDepth, hi] with hi = far or +inf, render/depth_format_impl.h), which the
 //    one-surface depths' range decides for all of them at once, per format; otherwise they are
 //    encoded one by one.
-void markFights(const TwoNearest &two, const Camera &cam, const ZFightSettings &settings, ZFightResult &r) {
+void markFights(const TwoNearest &two, const TwoSurfaces &lists, const Camera &cam, const ZFightSettings &settings,
+                ZFightResult &r) {
     const size_t N = two.pixels(), F = settings.formats.size();
-    // The two-surface pixels' lists, sized by the caller's count (the thread's storage, kept from
-    // view to view: only its first n2 entries are this view's).
-    thread_local std::vector<uint32_t> pixel;
-    thread_local std::vector<double> near1, near2;
-    if (pixel.size() < r.twoSurfacePixels) {
-        pixel.resize(r.twoSurfacePixels);
-        near1.resize(r.twoSurfacePixels);
-        near2.resize(r.twoSurfacePixels);
-    }
-    double oneMin = kInf, oneMax = -kInf;
-    bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
-    size_t n2 = 0;
-    {
-        uint32_t *__restrict px = pixel.data();
-        double *__restrict a = near1.data(), *__restrict b = near2.data();
-        for (size_t p = 0; p < N; ++p) {
-            if (two.screen1[p] == kNoFragment) continue;
-            const double d1 = two.depth1[p];
-            // n2 < r.twoSurfacePixels always holds here (the caller counted the second surfaces,
-            // and one is kept only after a first); the test keeps the writes inside the lists.
-            if (two.screen2[p] != kNoFragment && n2 < r.twoSurfacePixels) {
-                px[n2] = uint32_t(p);
-                a[n2] = d1;
-                b[n2] = two.depth2[p];
-                ++n2;
-            } else {
-                oneMin = std::min(oneMin, d1);
-                oneMax = std::max(oneMax, d1);
-                oneUnordered |= d1 != d1;
-            }
-        }
-    }
+    const std::vector<uint32_t> &pixel = lists.pixel;
+    const std::vector<double> &near1 = lists.near1, &near2 = lists.near2;
+    const size_t n2 = lists.n;
+    const double oneMin = lists.oneMin, oneMax = lists.oneMax;
+    const bool oneUnordered = lists.oneUnordered;
     // The finite positive depths' range of the two-surface pixels, over the gathered lists in four
     // independent lanes (one running minimum would wait on the previous one's latency at every
     // pixel); the smallest and largest of a set of such numbers do not depend on the order.
@@ -865,13 +1034,18 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     // This thread's buffers, reused from view to view: a fresh 1080p set (48 MB) cost more in page
     // faults than filling it.
     thread_local TwoNearest two;
-    findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided, two);
-    for (size_t p = 0; p < N; ++p) {
-        if (two.screen1[p] != kNoFragment) ++r.coveredPixels;
-        if (two.screen2[p] != kNoFragment) ++r.twoSurfacePixels;
+    thread_local TwoSurfaces lists;
+    lists.clear();
+    if (!settings.reference ||
+        !findTwoNearestFromReference(scene, *settings.reference, tris, W, H, cam.orthographic, settings.singleSided, two,
+                                     [&](size_t p0, size_t p1) { lists.gather(two, p0, p1); })) {
+        findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided, two);
+        lists.gather(two, 0, N);
     }
+    r.coveredPixels = lists.covered;
+    r.twoSurfacePixels = lists.n;
 
-    markFights(two, cam, settings, r);
+    markFights(two, lists, cam, settings, r);
     const double minSeparatedGap = classifyFights(scene, cam, tris, two, settings, r);
     findHotspots(scene, cam, tris, two, settings, r);
     recommend(minSeparatedGap, r);

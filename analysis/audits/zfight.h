@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,6 +57,21 @@ TwoNearest findTwoNearest(const ScreenTriangles &tris, int width, int height, bo
 // The same into `out`, its storage reused.
 void findTwoNearest(const ScreenTriangles &tris, int width, int height, bool orthographic, const uint8_t *singleSided,
                     TwoNearest &out);
+
+struct ReferenceVisibility;
+// The same result, reading the fragments the reference visibility recorded for this view
+// (audit.h: its fragment cache, complete) instead of walking them again: a screen triangle of
+// `tris` takes its fragments from the reference's screen triangle of the same source and piece when
+// the two have the same corners and depth plane and the reference's walk drew it (its single-sided
+// rule, singleSidedTriangles of `scene`): forEachFragment gives both the same fragments. The others
+// are walked here. Fragments are applied band by band (the per-pixel state of 16 rows stays in the
+// core's cache), in each band by triangle in submission order, so each pixel sees its fragments in
+// the walk's order; bandDone(p0, p1), when given, is called once pixels [p0, p1) are final (while
+// they are still in the cache). Returns false (out untouched) when the reference has no complete
+// cache.
+bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref, const ScreenTriangles &tris,
+                                 int width, int height, bool orthographic, const uint8_t *singleSided, TwoNearest &out,
+                                 const std::function<void(size_t, size_t)> &bandDone = {});
 
 // ---- Pixels that cannot fight, decided without encoding (zfight.cpp, 2a) ----------------------
 
@@ -127,6 +143,9 @@ struct ZFightSettings {
     // As ZBufferSettings::singleSided: per source triangle, nonzero = drawn only with the front
     // winding on screen. Pass the pointer the view's z-buffer gets (null: every triangle counts).
     const uint8_t *singleSided = nullptr;
+    // The view's reference visibility, when the audit ran and still holds its fragment cache: the
+    // two nearest surfaces are read from it (findTwoNearestFromReference; the same result).
+    const ReferenceVisibility *reference = nullptr;
 };
 
 struct ZFightFormatStats {
