@@ -1020,13 +1020,11 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         // first drawn of equal depths stays) in submission order is the "submitted" draw above:
         // the same fragments through the same test, so the same ids and passes. Its overdraw
         // divides by the pixels holding a fragment, as the z-buffer's statistics do.
-        const Stopwatch tz;
-        std::vector<uint8_t> touched(pixels, 0);
-        for (uint32_t p : v.fragments->pixel) touched[p] = 1;
-        uint64_t covered = 0;
-        for (uint8_t t : touched) covered += t;
+        // The pixels holding a fragment are those the painter's draw covered: it draws every
+        // cached fragment, without the depth test.
+        const uint64_t covered = r.painter.coveredPixels;
         const DrawStats &sub = r.overdrawByOrder[0].stats;
-        zrow.drawMs = sub.ms + tz.ms();
+        zrow.drawMs = sub.ms;
         const PixelComparison c = compareWithReference(v, ref, submittedIds);
         zrow.wrongPixels = c.wrongPixels;
         zrow.tiePixels = c.tiePixels;
