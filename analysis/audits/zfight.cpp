@@ -673,11 +673,15 @@ struct TwoSurfaces {
     size_t n = 0;
     double oneMin = kInf, oneMax = -kInf;
     bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
-    uint64_t covered = 0;       // pixels with a surface
+    // The finite positive depths' range of the two-surface pixels (both surfaces); the smallest and
+    // largest of a set of such numbers do not depend on the order they come in. Nothing: +inf, 0.
+    double twoMin = kInf, twoMax = 0;
+    uint64_t covered = 0;  // pixels with a surface
 
     void clear() {
         n = 0;
         oneMin = kInf, oneMax = -kInf;
+        twoMin = kInf, twoMax = 0;
         oneUnordered = false;
         covered = 0;
     }
@@ -695,17 +699,23 @@ struct TwoSurfaces {
         const double *d1s = two.depth1.data(), *d2s = two.depth2.data();
         size_t m = n;
         uint64_t cov = 0;
-        double lo = oneMin, hi = oneMax;
+        double lo = oneMin, hi = oneMax, twoLo = twoMin, twoHi = twoMax;
         bool unordered = oneUnordered;
         for (size_t p = p0; p < p1; ++p) {
             if (s1[p] == kNoFragment) continue;
             ++cov;
             const double d1 = d1s[p];
             if (s2[p] != kNoFragment) {
+                const double d2 = d2s[p];
                 px[m] = uint32_t(p);
                 a[m] = d1;
-                b[m] = d2s[p];
+                b[m] = d2;
                 ++m;
+                for (const double x : {d1, d2}) {
+                    const bool ok = x > 0 && x < kInf;  // finite and positive (false for NaN)
+                    twoLo = ok && x < twoLo ? x : twoLo;
+                    twoHi = ok && x > twoHi ? x : twoHi;
+                }
             } else {
                 lo = std::min(lo, d1);
                 hi = std::max(hi, d1);
@@ -715,6 +725,7 @@ struct TwoSurfaces {
         n = m;
         covered += cov;
         oneMin = lo, oneMax = hi, oneUnordered = unordered;
+        twoMin = twoLo, twoMax = twoHi;
     }
 };
 
@@ -734,23 +745,7 @@ void markFights(const TwoNearest &two, const TwoSurfaces &lists, const Camera &c
     const size_t n2 = lists.n;
     const double oneMin = lists.oneMin, oneMax = lists.oneMax;
     const bool oneUnordered = lists.oneUnordered;
-    // The finite positive depths' range of the two-surface pixels, over the gathered lists in four
-    // independent lanes (one running minimum would wait on the previous one's latency at every
-    // pixel); the smallest and largest of a set of such numbers do not depend on the order.
-    double twoMin = kInf, twoMax = 0;
-    {
-        double lo[4] = {kInf, kInf, kInf, kInf}, hi[4] = {0, 0, 0, 0};
-        for (const std::vector<double> *list : {&near1, &near2}) {
-            const double *d = list->data();  // its first n2
-            for (size_t k = 0; k < n2; ++k) {
-                const double x = d[k];
-                const bool ok = x > 0 && x < kInf;  // finite and positive (false for NaN)
-                lo[k & 3] = ok && x < lo[k & 3] ? x : lo[k & 3];
-                hi[k & 3] = ok && x > hi[k & 3] ? x : hi[k & 3];
-            }
-        }
-        for (int j = 0; j < 4; ++j) twoMin = std::min(twoMin, lo[j]), twoMax = std::max(twoMax, hi[j]);
-    }
+    const double twoMin = lists.twoMin, twoMax = lists.twoMax;
     thread_local std::vector<uint32_t> mask, cell1, cell2, unsafe;  // per two-surface pixel, as above
     if (mask.size() < n2) mask.resize(n2), cell1.resize(n2), cell2.resize(n2);
     std::fill_n(mask.begin(), n2, 0u);
