@@ -507,9 +507,11 @@ uint8_t depthGray(double d, double dMin, double dMax) { return DepthGrayScale(dM
 // monotone under rounding; glibc's log is within 0.52 ulp of log d (its implementation's stated
 // bound), taken as 4 ulps (8u |log d| <= 8u L, L the largest |log| involved), so for d' = d (1 + r)
 // the computed logs keep their order once log(1 + r) >= r / 2 exceeds 16u L: rho = 32u L.
-std::vector<uint8_t> depthGrays(const std::vector<double> &depth) {
+std::vector<uint8_t> depthGrays(const std::vector<double> &depth, double *dMin, double *dMax) {
     double lo, hi;
     depthRange(depth, &lo, &hi);
+    if (dMin) *dMin = lo;
+    if (dMax) *dMax = hi;
     const DepthGrayScale scale(lo, hi);
     std::vector<uint8_t> g(depth.size());
     if (!scale.valid || !scale.spread) {  // no logarithm to spare
@@ -554,6 +556,37 @@ std::vector<uint8_t> depthGrays(const std::vector<double> &depth) {
     return g;
 }
 
+std::vector<uint8_t> depthGraysFrom(const std::vector<double> &depth, const std::vector<double> &known,
+                                    const std::vector<uint8_t> &knownGrays, double knownMin, double knownMax) {
+    const size_t n = depth.size();
+    if (known.size() != n || knownGrays.size() != n || n > UINT32_MAX) return depthGrays(depth);
+    // One pass: the grays copied, the pixels whose depths differ listed, and depth's range (in four
+    // lanes without branches; the smallest and largest finite positive depths do not depend on the
+    // order they are met in).
+    std::vector<uint8_t> g(knownGrays);
+    thread_local std::vector<uint32_t> differ;
+    differ.clear();
+    double lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY}, hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    const double *__restrict a = depth.data(), *__restrict b = known.data();
+    for (size_t i = 0; i < n; ++i) {
+        const double d = a[i];
+        uint64_t x, y;
+        std::memcpy(&x, &d, sizeof x);
+        std::memcpy(&y, &b[i], sizeof y);
+        if (x != y) [[unlikely]]
+            differ.push_back(uint32_t(i));
+        const bool ok = d > 0 && d < INFINITY;  // finite and positive (false for NaN)
+        lo[i & 3] = ok && d < lo[i & 3] ? d : lo[i & 3];
+        hi[i & 3] = ok && d > hi[i & 3] ? d : hi[i & 3];
+    }
+    const double dMin = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
+    const double dMax = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
+    if (!(dMin == knownMin && dMax == knownMax)) return depthGrays(depth);
+    const DepthGrayScale scale(dMin, dMax);
+    for (const uint32_t i : differ) g[i] = scale(a[i]);
+    return g;
+}
+
 // ---- Writing ----------------------------------------------------------------------------------
 
 bool writeViewImages(const ViewResult &view, const std::string &dir, const std::string &baseName,
@@ -572,14 +605,18 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
     const ViewImageNames names = viewImageNames(baseName);
     const std::string prefix = dir.empty() ? std::string() : (dir.back() == '/' ? dir : dir + "/");
     // The grays of the z-buffer's and the reference's depths, computed once for every image drawn
-    // over them (depthGrays), when the first such image is written.
+    // over them (depthGrays), when the first such image is written; the reference's from the
+    // z-buffer's when those are at hand (depthGraysFrom: the two buffers differ at a few pixels).
     std::optional<std::vector<uint8_t>> zGraysMemo, refGraysMemo;
+    double zMin = 0, zMax = 0;
     auto zGrays = [&]() -> const std::vector<uint8_t> * {
-        if (!zGraysMemo) zGraysMemo = depthGrays(zb.depth);
+        if (!zGraysMemo) zGraysMemo = depthGrays(zb.depth, &zMin, &zMax);
         return &*zGraysMemo;
     };
     auto refGrays = [&]() -> const std::vector<uint8_t> * {
-        if (!refGraysMemo) refGraysMemo = depthGrays(view.audit->reference.depth);
+        const std::vector<double> &depth = view.audit->reference.depth;
+        if (!refGraysMemo)
+            refGraysMemo = zGraysMemo ? depthGraysFrom(depth, zb.depth, *zGraysMemo, zMin, zMax) : depthGrays(depth);
         return &*refGraysMemo;
     };
 

@@ -153,7 +153,14 @@ inline DepthGrayScale depthGrayScale(const std::vector<double> &depth) {
 
 // A depth buffer's gray per pixel (depthGrayScale over its own range): computed once per view and
 // shared by every image drawn over that buffer (a logarithm per pixel, not one per pixel and image).
-std::vector<uint8_t> depthGrays(const std::vector<double> &depth);
+// The grays' range (depthRange) is stored where asked.
+std::vector<uint8_t> depthGrays(const std::vector<double> &depth, double *dMin = nullptr, double *dMax = nullptr);
+// The same grays, from those of another buffer that mostly holds the same depths (knownGrays =
+// depthGrays(known, &knownMin, &knownMax); a view's reference and z-buffer depths differ at a few
+// pixels): where both buffers have the same range, a pixel with the same depth (bit for bit) has
+// the same gray, and only the others are computed. Another range, or another size: depthGrays.
+std::vector<uint8_t> depthGraysFrom(const std::vector<double> &depth, const std::vector<double> &known,
+                                    const std::vector<uint8_t> &knownGrays, double knownMin, double knownMax);
 // An image writer's grays by pixel: the caller's shared ones (depthGrays of the same buffer) when
 // given, else computed here; the same bytes either way.
 class PixelGrays {

@@ -680,6 +680,44 @@ TEST(ReportImages, DepthGraysMatchTheScaleAtEveryBoundary) {
     EXPECT_GT(checked, 100000u);
 }
 
+// depthGraysFrom gives depthGrays's grays: for a buffer that differs from the known one at some
+// pixels (other depths in the range, background, +inf, NaN, 0, negative depths where the known
+// buffer has depths and the reverse), for one whose changes move its range (a new nearest or
+// farthest depth: every gray changes), and for a known buffer of another size.
+TEST(ReportImages, DepthGraysFromAMostlyEqualBufferAreItsOwn) {
+    uint64_t state = 11;
+    auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1p-53;
+    };
+    std::vector<double> known(50000);
+    for (double &d : known) d = next() < 0.1 ? INFINITY : 0.5 * std::pow(4000.0, next());
+    known[7] = 0.5, known[8] = 2000;  // the range's ends, kept by every variant but the last
+    double kMin, kMax;
+    const std::vector<uint8_t> knownGrays = depthGrays(known, &kMin, &kMax);
+    EXPECT_EQ(kMin, 0.5);
+    EXPECT_EQ(kMax, 2000);
+    const double odd[] = {INFINITY, NAN, 0.0, -3.0, -INFINITY, 0.75, 1999.0, std::nextafter(0.5, 1.0)};
+    for (int variant = 0; variant < 3; ++variant) {
+        std::vector<double> depth = known;
+        for (int k = 0; k < 300; ++k) {
+            const size_t p = 9 + size_t(next() * double(depth.size() - 9));
+            depth[p] = k % 3 == 0 ? odd[k % std::size(odd)] : 0.5 * std::pow(4000.0, next());
+        }
+        if (variant == 1) depth[100] = 0.25;   // a nearer depth: another range
+        if (variant == 2) depth[200] = 4000;   // a farther one
+        const std::vector<uint8_t> want = depthGrays(depth);
+        EXPECT_TRUE(depthGraysFrom(depth, known, knownGrays, kMin, kMax) == want) << variant;
+        if (variant == 0) EXPECT_FALSE(want == knownGrays);  // the changed pixels changed grays
+        // The other range moved the grays (the old nearest is no longer white, the old farthest
+        // no longer the farthest gray).
+        if (variant == 1) EXPECT_NE(want[7], knownGrays[7]);
+        if (variant == 2) EXPECT_NE(want[8], knownGrays[8]);
+    }
+    const std::vector<double> shorter(known.begin(), known.end() - 1);
+    EXPECT_TRUE(depthGraysFrom(shorter, known, knownGrays, kMin, kMax) == depthGrays(shorter));
+}
+
 TEST(ReportImages, WriteAndReadBack) {
     TempDir dir;
     ASSERT_FALSE(dir.path.empty());
