@@ -688,7 +688,8 @@ struct TwoSurfaces {
     // Pixels [p0, p1) of `two`, after those gathered before.
     void gather(const TwoNearest &two, size_t p0, size_t p1) {
         if (pixel.size() < n + (p1 - p0)) {
-            const size_t size = std::max(n + (p1 - p0), pixel.size() + pixel.size() / 2);
+            // Grown by half, never beyond the view's pixels (estimateMemory's bound): n <= p0.
+            const size_t size = std::min(std::max(n + (p1 - p0), pixel.size() + pixel.size() / 2), two.pixels());
             pixel.resize(size);
             near1.resize(size);
             near2.resize(size);
