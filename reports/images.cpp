@@ -560,29 +560,22 @@ std::vector<uint8_t> depthGraysFrom(const std::vector<double> &depth, const std:
                                     const std::vector<uint8_t> &knownGrays, double knownMin, double knownMax) {
     const size_t n = depth.size();
     if (known.size() != n || knownGrays.size() != n || n > UINT32_MAX) return depthGrays(depth);
-    // One pass: the grays copied, the pixels whose depths differ listed, and depth's range (in four
-    // lanes without branches; the smallest and largest finite positive depths do not depend on the
-    // order they are met in).
+    // The grays copied and the pixels whose depths differ listed. depth has known's range when no
+    // differing pixel has a finite positive depth outside it and none held one of its ends in known:
+    // every other pixel has known's depth, and known's ends are then met at such pixels.
     std::vector<uint8_t> g(knownGrays);
     thread_local std::vector<uint32_t> differ;
     differ.clear();
-    double lo[4] = {INFINITY, INFINITY, INFINITY, INFINITY}, hi[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
     const double *__restrict a = depth.data(), *__restrict b = known.data();
-    for (size_t i = 0; i < n; ++i) {
-        const double d = a[i];
-        uint64_t x, y;
-        std::memcpy(&x, &d, sizeof x);
-        std::memcpy(&y, &b[i], sizeof y);
-        if (x != y) [[unlikely]]
+    for (size_t i = 0; i < n; ++i)
+        if (std::memcmp(&a[i], &b[i], sizeof a[i]) != 0) [[unlikely]]
             differ.push_back(uint32_t(i));
-        const bool ok = d > 0 && d < INFINITY;  // finite and positive (false for NaN)
-        lo[i & 3] = ok && d < lo[i & 3] ? d : lo[i & 3];
-        hi[i & 3] = ok && d > hi[i & 3] ? d : hi[i & 3];
+    for (const uint32_t i : differ) {
+        const double d = a[i];
+        const bool inside = !(d > 0 && d < INFINITY) || (d >= knownMin && d <= knownMax);
+        if (!inside || b[i] == knownMin || b[i] == knownMax) return depthGrays(depth);
     }
-    const double dMin = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
-    const double dMax = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
-    if (!(dMin == knownMin && dMax == knownMax)) return depthGrays(depth);
-    const DepthGrayScale scale(dMin, dMax);
+    const DepthGrayScale scale(knownMin, knownMax);
     for (const uint32_t i : differ) g[i] = scale(a[i]);
     return g;
 }

@@ -683,7 +683,8 @@ TEST(ReportImages, DepthGraysMatchTheScaleAtEveryBoundary) {
 // depthGraysFrom gives depthGrays's grays: for a buffer that differs from the known one at some
 // pixels (other depths in the range, background, +inf, NaN, 0, negative depths where the known
 // buffer has depths and the reverse), for one whose changes move its range (a new nearest or
-// farthest depth: every gray changes), and for a known buffer of another size.
+// farthest depth, or the known nearest or farthest one changed to a depth inside: every gray
+// changes), and for a known buffer of another size.
 TEST(ReportImages, DepthGraysFromAMostlyEqualBufferAreItsOwn) {
     uint64_t state = 11;
     auto next = [&] {
@@ -713,6 +714,12 @@ TEST(ReportImages, DepthGraysFromAMostlyEqualBufferAreItsOwn) {
         // no longer the farthest gray).
         if (variant == 1) EXPECT_NE(want[7], knownGrays[7]);
         if (variant == 2) EXPECT_NE(want[8], knownGrays[8]);
+    }
+    for (const size_t end : {size_t(7), size_t(8)}) {  // the known range's ends, moved inside it
+        std::vector<double> depth = known;
+        depth[end] = 3.0;
+        EXPECT_TRUE(depthGraysFrom(depth, known, knownGrays, kMin, kMax) == depthGrays(depth)) << end;
+        EXPECT_FALSE(depthGrays(depth) == knownGrays) << end;
     }
     const std::vector<double> shorter(known.begin(), known.end() - 1);
     EXPECT_TRUE(depthGraysFrom(shorter, known, knownGrays, kMin, kMax) == depthGrays(shorter));
