@@ -721,6 +721,70 @@ TEST(ZFightCases, WideRangeNear1e3Far1e6FormatsFollowTheirMath) {
     }
 }
 
+// The fight bits and out-of-range counts against every pixel's two surfaces encoded in every format:
+// the pixels the filter leaves out while gathering (2a) change nothing. Every demo view, with the
+// default formats (all filtered: only the pixels that may fight are listed) and with every format
+// (f32_gl is never filtered: every two-surface pixel is listed), walked and from the reference.
+TEST(ZFightCases, FightBitsEqualEncodingEveryPixel) {
+    std::vector<DepthFormatSpec> every;
+    for (const DepthFormat fmt : allDepthFormats()) every.push_back(fmt);
+    uint64_t fighting = 0, outOfRange = 0;
+    auto check = [&](const Scene &scene, const Camera &cam, const std::string &name) {
+        const ScreenTriangles tris = screenTriangles(scene, cam);
+        const ReferenceVisibility ref = referenceVisibility(scene, cam, uint64_t(1) << 26);
+        TwoNearest two;
+        findTwoNearest(tris, cam.width, cam.height, cam.orthographic, nullptr, two);
+        for (const bool all : {false, true})
+            for (const bool fromReference : {false, true}) {
+                ZFightSettings settings;
+                if (all) settings.formats = every;
+                if (fromReference) settings.reference = &ref;
+                const ZFightResult r = analyzeZFighting(scene, cam, tris, settings);
+                ASSERT_TRUE(r.error.empty()) << r.error;
+                const std::string what = name + (all ? " every format" : " default formats") +
+                                         (fromReference ? ", from the reference" : ", walked");
+                uint64_t twoSurfaces = 0;
+                std::vector<uint64_t> oor(settings.formats.size(), 0);
+                for (size_t p = 0; p < two.pixels(); ++p) {
+                    if (two.screen1[p] == kNoFragment) continue;
+                    const bool second = two.screen2[p] != kNoFragment;
+                    twoSurfaces += second;
+                    uint32_t mask = 0;
+                    for (size_t i = 0; i < settings.formats.size(); ++i) {
+                        const DepthEncoder e = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
+                        bool o1 = false, o2 = false;
+                        const uint32_t k1 = depthKey(e, two.depth1[p], &o1);
+                        const uint32_t k2 = second ? depthKey(e, two.depth2[p], &o2) : 0;
+                        mask |= second && k1 >= k2 ? uint32_t(1) << i : 0;
+                        oor[i] += o1 || o2;
+                    }
+                    ASSERT_EQ(r.fightMask[p], mask) << what << " pixel " << p;
+                    fighting += mask != 0;
+                }
+                EXPECT_EQ(r.twoSurfacePixels, twoSurfaces) << what;
+                for (size_t i = 0; i < settings.formats.size(); ++i) {
+                    EXPECT_EQ(r.perFormat[i].outOfRangePixels, oor[i]) << what << " " << r.perFormat[i].name;
+                    outOfRange += oor[i];
+                }
+            }
+    };
+    const Scene demo = demoScene();
+    ASSERT_FALSE(demo.views.empty());
+    for (const ViewSpec &view : demo.views) {
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(view.camera, &cam, &err)) << err;
+        check(demo, cam, view.name);
+    }
+    // The decal at 0.5 m of WideRangeNear1e3Far1e6FormatsFollowTheirMath: every pixel out of range
+    // for the formats that cannot hold d < 1.
+    const Scene decal = sceneOf({{"floor", quadY(-4, 4, -4, 4, 0)},
+                                 {"decal", quadY(-0.0625, 0.0625, -0.0625, 0.0625, 0.001)}});
+    check(decal, downCamera(0.5, 1e-3, 1e6), "decal at 0.5 m");
+    EXPECT_GT(fighting, 0u);  // the demo's decal and the formats' limits: bits to get wrong
+    EXPECT_GT(outOfRange, 0u);
+}
+
 TEST(ZFightCases, EveryFormatFightingMeansNoRecommendation) {
     // Two parallel planes 1e-11 apart at d = 10: farther apart than coplanar allows
     // (64 * 2^-53 * 40 = 2.8e-13 for coordinates up to 40) but closer than any format resolves

@@ -20,6 +20,7 @@
 #include <cstring>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include "analysis/audits/audit.h"
@@ -52,21 +53,23 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Keeps fragment (pixel, depth d) of screen triangle t, whose source is `current`, among the
-// pixel's two nearest surfaces. Fragments arrive in submission order, so "strictly nearer"
-// comparisons keep the first drawn in front on equal depths, exactly like the z-buffer's LESS
-// test on equal keys.
-inline void keepTwoNearest(TwoNearest &out, const uint32_t *source, size_t pixel, uint32_t t, uint32_t current,
-                           double d) {
+// Keeps fragment (pixel, depth d) of screen triangle t among the pixel's two nearest surfaces.
+// Fragments arrive in submission order, so "strictly nearer" comparisons keep the first drawn in
+// front on equal depths, exactly like the z-buffer's LESS test on equal keys. `first` is the first
+// screen triangle of t's source: a source's clipped pieces are consecutive, so a kept triangle
+// from `first` on is one of them (nothing after them has arrived yet), and kNoFragment + 1 wraps
+// to 0, below every `first`.
+inline void keepTwoNearest(TwoNearest &out, size_t pixel, uint32_t t, uint32_t first, double d) {
     double &d1 = out.depth1[pixel], &d2 = out.depth2[pixel];
     uint32_t &t1 = out.screen1[pixel], &t2 = out.screen2[pixel];
+    static_assert(uint32_t(kNoFragment + 1) == 0);
     // Same surface as a kept one (another clipped piece of the same source triangle): keep the
     // nearer depth of that surface, never a second slot for it.
-    if (t1 != kNoFragment && source[t1] == current) {
+    if (uint32_t(t1 + 1) > first) {
         if (d < d1) d1 = d, t1 = t;
         return;
     }
-    if (t2 != kNoFragment && source[t2] == current) {
+    if (uint32_t(t2 + 1) > first) {
         if (d < d2) {
             d2 = d, t2 = t;
             if (d2 < d1) std::swap(d1, d2), std::swap(t1, t2);
@@ -92,13 +95,14 @@ struct TwoNearestSink {
     TwoNearest *out;
     const uint32_t *source;       // ScreenTriangles::source
     const uint8_t *singleSided;   // as ZBufferSettings::singleSided (may be null)
-    uint32_t current = 0;         // source triangle of the triangle being walked
+    uint32_t first = 0;           // first screen triangle of the walked triangle's source
 
     bool beginTriangle(size_t t, bool frontWinding) {
-        current = source[t];
+        const uint32_t current = source[t];
+        for (first = uint32_t(t); first > 0 && source[first - 1] == current;) --first;
         return drawn(singleSided, current, frontWinding);
     }
-    void fragment(size_t pixel, size_t t, double d) { keepTwoNearest(*out, source, pixel, uint32_t(t), current, d); }
+    void fragment(size_t pixel, size_t t, double d) { keepTwoNearest(*out, pixel, uint32_t(t), first, d); }
     void endTriangle(size_t, uint64_t) {}
 };
 
@@ -185,8 +189,8 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
     // reference's cache, or (side) of the fragments walked here.
     struct Run {
         uint64_t at, end;
-        uint32_t tri;
-        uint32_t side;  // 0: the reference's cache; else 1 + index into `walk`
+        uint32_t tri, first;  // the screen triangle and its source's first (keepTwoNearest)
+        uint32_t side;        // 0: the reference's cache; else 1 + index into `walk`
     };
     thread_local std::vector<Run> runs;
     thread_local ScreenTriangles walk;
@@ -204,10 +208,11 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
         const size_t t = s < sources && firstOf[s] != UINT32_MAX ? size_t(firstOf[s]) + piece : SIZE_MAX;
         if (t < rs.size() && rs.source[t] == s && std::memcmp(xy, &rs.xy[6 * t], 6 * sizeof(int32_t)) == 0 &&
             samePlane(plane, rs.planes[rs.plane[t]]) && drawn(refSingleSided.data(), s, front)) {
-            if (cache.begin[t + 1] > cache.begin[t]) runs.push_back({cache.begin[t], cache.begin[t + 1], uint32_t(j), 0});
+            if (cache.begin[t + 1] > cache.begin[t])
+                runs.push_back({cache.begin[t], cache.begin[t + 1], uint32_t(j), uint32_t(j - piece), 0});
             continue;
         }
-        runs.push_back({0, 0, uint32_t(j), uint32_t(walk.size()) + 1});
+        runs.push_back({0, 0, uint32_t(j), uint32_t(j - piece), uint32_t(walk.size()) + 1});
         walk.xy.insert(walk.xy.end(), xy, xy + 6);
         walk.source.push_back(s);
         walk.plane.push_back(uint32_t(walk.planes.size()));
@@ -234,7 +239,6 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
         const uint32_t *px = pixelsOf(u);
         return std::pair<size_t, size_t>{px[u.at] / bandPixels, px[u.end - 1] / bandPixels};
     }, bandBegin, bandRuns);
-    const uint32_t *source = tris.source.data();
     for (size_t b = 0; b < bands; ++b) {
         const size_t p0 = b * bandPixels, p1 = std::min(p0 + bandPixels, n);
         std::fill(r.depth1.begin() + p0, r.depth1.begin() + p1, kInf);
@@ -245,9 +249,8 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
             Run &u = runs[bandRuns[k]];
             const uint32_t *pixelOf = pixelsOf(u);
             const double *depthOf = u.side ? walked.depth.data() : cache.depth.data();
-            const uint32_t current = source[u.tri];
             uint64_t f = u.at;
-            for (; f < u.end && pixelOf[f] < p1; ++f) keepTwoNearest(r, source, pixelOf[f], u.tri, current, depthOf[f]);
+            for (; f < u.end && pixelOf[f] < p1; ++f) keepTwoNearest(r, pixelOf[f], u.tri, u.first, depthOf[f]);
             u.at = f;
         }
         if (bandDone) bandDone(p0, p1);
@@ -664,125 +667,128 @@ uint32_t FightFilter::cell(double d) const {
 
 namespace {
 
-// The pixels with two surfaces as lists (pixel, nearer depth, farther depth), the range of the
-// depths of the pixels with one surface, and the counts; gathered a stretch of pixels at a time
-// (the thread's storage, kept from view to view: only the first n entries are this view's).
+// The pixels with two surfaces that may fight as lists (pixel, nearer depth, farther depth), the
+// range of the depths of the pixels with one surface, and the counts; gathered a stretch of pixels
+// at a time (the thread's storage, kept from view to view: only the first n entries are this
+// view's). A pixel the filter decides cannot fight in any format (2a) is counted, not listed;
+// every two-surface pixel is listed when a format is not filtered.
 struct TwoSurfaces {
     std::vector<uint32_t> pixel;
     std::vector<double> near1, near2;
-    size_t n = 0;
+    size_t n = 0;        // listed
+    uint64_t two = 0;    // pixels with two surfaces (listed or not)
     double oneMin = kInf, oneMax = -kInf;
     bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
-    // The finite positive depths' range of the two-surface pixels (both surfaces); the smallest and
-    // largest of a set of such numbers do not depend on the order they come in. Nothing: +inf, 0.
-    double twoMin = kInf, twoMax = 0;
     uint64_t covered = 0;  // pixels with a surface
 
     void clear() {
         n = 0;
+        two = 0;
         oneMin = kInf, oneMax = -kInf;
-        twoMin = kInf, twoMax = 0;
         oneUnordered = false;
         covered = 0;
     }
     // Pixels [p0, p1) of `two`, after those gathered before.
-    void gather(const TwoNearest &two, size_t p0, size_t p1) {
-        if (pixel.size() < n + (p1 - p0)) {
-            // Grown by half, never beyond the view's pixels (estimateMemory's bound): n <= p0.
-            const size_t size = std::min(std::max(n + (p1 - p0), pixel.size() + pixel.size() / 2), two.pixels());
-            pixel.resize(size);
-            near1.resize(size);
-            near2.resize(size);
-        }
-        uint32_t *__restrict px = pixel.data();
-        double *__restrict a = near1.data(), *__restrict b = near2.data();
-        const uint32_t *s1 = two.screen1.data(), *s2 = two.screen2.data();
-        const double *d1s = two.depth1.data(), *d2s = two.depth2.data();
-        size_t m = n;
-        uint64_t cov = 0;
-        double lo = oneMin, hi = oneMax, twoLo = twoMin, twoHi = twoMax;
+    void gather(const TwoNearest &twoNearest, const FightFilter &filter, size_t p0, size_t p1) {
+        const bool listAll = !filter.filteredAll();
+        const uint32_t *s1 = twoNearest.screen1.data(), *s2 = twoNearest.screen2.data();
+        const double *d1s = twoNearest.depth1.data(), *d2s = twoNearest.depth2.data();
+        uint64_t cov = 0, pairs = 0;
+        double lo = oneMin, hi = oneMax;
         bool unordered = oneUnordered;
         for (size_t p = p0; p < p1; ++p) {
             if (s1[p] == kNoFragment) continue;
             ++cov;
             const double d1 = d1s[p];
             if (s2[p] != kNoFragment) {
+                ++pairs;
                 const double d2 = d2s[p];
-                px[m] = uint32_t(p);
-                a[m] = d1;
-                b[m] = d2;
-                ++m;
-                for (const double x : {d1, d2}) {
-                    const bool ok = x > 0 && x < kInf;  // finite and positive (false for NaN)
-                    twoLo = ok && x < twoLo ? x : twoLo;
-                    twoHi = ok && x > twoHi ? x : twoHi;
+                if (!listAll && filter.cannotFightAny(filter.cell(d1), filter.cell(d2))) continue;
+                if (n == pixel.size()) {
+                    // Grown by half, never beyond the view's pixels (estimateMemory's bound).
+                    const size_t size = std::min(std::max<size_t>(n + 1024, n + n / 2), twoNearest.pixels());
+                    pixel.resize(size);
+                    near1.resize(size);
+                    near2.resize(size);
                 }
+                pixel[n] = uint32_t(p);
+                near1[n] = d1;
+                near2[n] = d2;
+                ++n;
             } else {
                 lo = std::min(lo, d1);
                 hi = std::max(hi, d1);
                 unordered |= d1 != d1;
             }
         }
-        n = m;
         covered += cov;
+        two += pairs;
         oneMin = lo, oneMax = hi, oneUnordered = unordered;
-        twoMin = twoLo, twoMax = twoHi;
+    }
+};
+
+// 2a's cells over the camera's depth range [near, far] (what the clip keeps; a depth outside is never
+// decided) and the formats' encoders: the thread's, kept while the camera's range and the formats
+// stay (every view of a run, usually).
+struct FilterForView {
+    double nearZ = std::numeric_limits<double>::quiet_NaN(), farZ = nearZ;
+    std::vector<DepthFormatSpec> formats;
+    std::vector<DepthEncoder> enc;
+    std::optional<FightFilter> filter;
+
+    const FightFilter &get(const Camera &cam, const std::vector<DepthFormatSpec> &specs) {
+        if (filter && doubleBits(nearZ) == doubleBits(cam.nearZ) && doubleBits(farZ) == doubleBits(cam.farZ) &&
+            formats == specs)
+            return *filter;
+        nearZ = cam.nearZ, farZ = cam.farZ, formats = specs;
+        enc.resize(specs.size());
+        for (size_t i = 0; i < specs.size(); ++i) enc[i] = makeDepthEncoder(specs[i], cam.nearZ, cam.farZ);
+        filter.emplace(enc, cam.nearZ, cam.farZ);
+        return *filter;
     }
 };
 
 // 2. Per format: the fight bit (key(d1) >= key(d2), d1 <= d2: equal stored values or swapped order)
-//    and out-of-range pixels (either surface clamped by the encoder). The two-surface pixels are
-//    gathered once into a compact list; those that cannot fight in any filtered format (2a) are set
-//    aside, and every format encodes the rest (every pixel, for a format not filtered). A
-//    one-surface pixel needs no encoding when its depth is in [minValidDepth, far] (every format
+//    and out-of-range pixels (either surface clamped by the encoder). The two-surface pixels that
+//    cannot fight in any filtered format (2a) were left out of the lists while gathering; every
+//    format encodes the listed pixels it does not filter out (every one, for a format not filtered).
+//    A one-surface pixel needs no encoding when its depth is in [minValidDepth, far] (every format
 //    clamps d into [minValidDepth, hi] with hi = far or +inf, render/depth_format_impl.h), which the
 //    one-surface depths' range decides for all of them at once, per format; otherwise they are
 //    encoded one by one.
-void markFights(const TwoNearest &two, const TwoSurfaces &lists, const Camera &cam, const ZFightSettings &settings,
-                ZFightResult &r) {
+void markFights(const TwoNearest &two, const TwoSurfaces &lists, const FilterForView &view,
+                const ZFightSettings &settings, ZFightResult &r) {
     const size_t N = two.pixels(), F = settings.formats.size();
     const std::vector<uint32_t> &pixel = lists.pixel;
     const std::vector<double> &near1 = lists.near1, &near2 = lists.near2;
     const size_t n2 = lists.n;
     const double oneMin = lists.oneMin, oneMax = lists.oneMax;
     const bool oneUnordered = lists.oneUnordered;
-    const double twoMin = lists.twoMin, twoMax = lists.twoMax;
-    thread_local std::vector<uint32_t> mask, cell1, cell2, unsafe;  // per two-surface pixel, as above
+    const FightFilter &filter = *view.filter;
+    thread_local std::vector<uint32_t> mask, cell1, cell2;  // per listed pixel
     if (mask.size() < n2) mask.resize(n2), cell1.resize(n2), cell2.resize(n2);
     std::fill_n(mask.begin(), n2, 0u);
-
-    // 2a. The pixels that cannot fight in any filtered format are set aside.
-    std::vector<DepthEncoder> enc(F);
-    for (size_t i = 0; i < F; ++i) enc[i] = makeDepthEncoder(settings.formats[i], cam.nearZ, cam.farZ);
-    const FightFilter filter(enc, n2 ? twoMin : 0, twoMax);
-    unsafe.clear();  // indices into the two-surface list
     for (size_t k = 0; k < n2; ++k) {
         cell1[k] = filter.cell(near1[k]);
         cell2[k] = filter.cell(near2[k]);
-        if (!filter.cannotFightAny(cell1[k], cell2[k])) unsafe.push_back(uint32_t(k));
     }
 
     for (size_t i = 0; i < F; ++i) {
-        const DepthEncoder &e = enc[i];
+        const DepthEncoder &e = view.enc[i];
         const uint32_t bit = uint32_t(1) << i;
         const double lo = e.minValidDepth, hi = e.farZ;
         const bool oneInRange = !oneUnordered && oneMin >= lo && oneMax <= hi;
         uint64_t oor = 0;
         dispatchDepthFormat(e.format, [&]<DepthFormat Fmt>() {
-            auto encodePixel = [&](size_t k) {
+            // The others cannot fight here and lie in the format's range (FightFilter).
+            for (size_t k = 0; k < n2; ++k) {
+                if (filter.cannotFight(i, cell1[k], cell2[k])) continue;
                 uint32_t k1 = 0, k2 = 0;
                 bool o1 = false, o2 = false;
                 encodeDepth<Fmt>(e, near1[k], k1, o1);
                 encodeDepth<Fmt>(e, near2[k], k2, o2);
                 mask[k] |= k1 >= k2 ? bit : 0;
                 oor += (o1 || o2) ? 1 : 0;
-            };
-            if (!filter.filtered(i)) {
-                for (size_t k = 0; k < n2; ++k) encodePixel(k);
-            } else {
-                // The others cannot fight here and lie in the format's range (FightFilter).
-                for (const uint32_t k : unsafe)
-                    if (!filter.cannotFight(i, cell1[k], cell2[k])) encodePixel(k);
             }
             if (oneInRange) return;
             for (size_t p = 0; p < N; ++p) {
@@ -1031,17 +1037,19 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     // faults than filling it.
     thread_local TwoNearest two;
     thread_local TwoSurfaces lists;
+    thread_local FilterForView filter;
+    const FightFilter &cells = filter.get(cam, settings.formats);
     lists.clear();
     if (!settings.reference ||
         !findTwoNearestFromReference(scene, *settings.reference, tris, W, H, cam.orthographic, settings.singleSided, two,
-                                     [&](size_t p0, size_t p1) { lists.gather(two, p0, p1); })) {
+                                     [&](size_t p0, size_t p1) { lists.gather(two, cells, p0, p1); })) {
         findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided, two);
-        lists.gather(two, 0, N);
+        lists.gather(two, cells, 0, N);
     }
     r.coveredPixels = lists.covered;
-    r.twoSurfacePixels = lists.n;
+    r.twoSurfacePixels = lists.two;
 
-    markFights(two, lists, cam, settings, r);
+    markFights(two, lists, filter, settings, r);
     const double minSeparatedGap = classifyFights(scene, cam, tris, two, settings, r);
     findHotspots(scene, cam, tris, two, settings, r);
     recommend(minSeparatedGap, r);

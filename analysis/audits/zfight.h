@@ -81,8 +81,8 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
 // in zfight.cpp.
 double monotoneWindow(const DepthEncoder &e);
 
-// Cells over a view's depth range [dMin, dMax] (equal steps of the doubles' bit patterns, at most
-// 4096, about 256 per octave) with, per format, the first cell from which a farther depth's key
+// Cells over a depth range [dMin, dMax] (the camera's [near, far] in the audit; equal steps of the
+// doubles' bit patterns, at most 4096, 256 or more per octave below a 2^16 ratio) with, per format, the first cell from which a farther depth's key
 // is certainly above a nearer depth's: a pair of depths d1 <= d2 in cells c1, c2 with
 // cannotFight(format, c1, c2) has key(d1) < key(d2) and both depths in the format's range, so it
 // neither fights nor is out of range there -- without encoding either depth.
@@ -90,6 +90,11 @@ struct FightFilter {
     FightFilter(const std::vector<DepthEncoder> &encoders, double dMin, double dMax);
     uint32_t cell(double d) const;  // `count` for depths outside the cells (never decided)
     bool filtered(size_t format) const { return windows[format] >= 0 && count > 0; }
+    bool filteredAll() const {
+        for (size_t i = 0; i < windows.size(); ++i)
+            if (!filtered(i)) return false;
+        return true;
+    }
     bool cannotFight(size_t format, uint32_t c1, uint32_t c2) const {
         const Cells &c = perFormat[format];
         return filtered(format) && c.firstSafe[c1] <= c2 && c2 <= c.last;
