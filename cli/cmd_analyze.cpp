@@ -219,7 +219,6 @@ int analyzeToReport(const AnalyzeOptions &o,
         fail(err);
         return kExitBadInput;
     }
-    setImageThreads(o.threads);
     const bool tty = isatty(fileno(stderr));
     std::atomic<int> done{0};
     std::mutex printMutex;

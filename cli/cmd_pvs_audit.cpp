@@ -130,7 +130,6 @@ int cmdPvsAudit(const PvsAuditOptions &o) {
         fail(err);
         return kExitBadInput;
     }
-    setImageThreads(o.threads);
     PvsAuditResult result;
     nlohmann::ordered_json json;
     const int code = runPvsAudit(o, scene, settings, out.staging(), o.pvsOut, &result, &json);

@@ -1,5 +1,5 @@
 // Per-view images: PNGs through libpng (palette images, encodePng), EXRs through OpenEXRCore
-// (writeExr), reading through OpenImageIO (the only file that includes these libraries' headers).
+// (writeExr); reading them is reports/image_read.cpp's.
 //
 //   BASE.depth.exr     one FLOAT channel "Z": the visible fragment's view depth d (double rounded to
 //                      float); background (no fragment) = +inf, so "nothing" is never mistaken for a
@@ -21,8 +21,6 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <OpenEXR/openexr.h>
 #include <png.h>
 #include <libdeflate.h>
@@ -39,16 +37,7 @@
 
 namespace va {
 
-void setImageThreads(int threads) {
-    OIIO::attribute("threads", threads);
-    OIIO::attribute("exr_threads", threads);
-}
-
 namespace {
-
-using OIIO::ImageInput;
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
 
 // ---- PNG ----------------------------------------------------------------------------------------
 // Every PNG is a visualization with few colors (a view's grays and a handful of highlight colors):
@@ -714,47 +703,6 @@ bool writeAllViewImages(const AnalysisResult &result, const std::string &dir, st
     const std::vector<std::string> bases = imageBaseNames(result.views);
     for (size_t i = 0; i < result.views.size(); ++i)
         if (!writeViewImages(result.views[i], dir, bases[i], err)) return false;
-    return true;
-}
-
-// ---- Reading ----------------------------------------------------------------------------------
-
-bool readImage(const std::string &path, ImageData *out, std::string *err) {
-    auto in = ImageInput::open(path);
-    if (!in) {
-        if (err) *err = "cannot read image '" + path + "': " + OIIO::geterror();
-        return false;
-    }
-    const ImageSpec &spec = in->spec();
-    ImageData d;
-    d.width = spec.width;
-    d.height = spec.height;
-    d.channelNames = spec.channelnames;
-    // Per-channel formats may differ; read every channel in the first channel's type (what our
-    // writers produce: one type per file).
-    const TypeDesc type = spec.channelformats.empty() ? spec.format : spec.channelformats[0];
-    d.pixelType = type.c_str();
-    const size_t count = size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels);
-    void *pixels = nullptr;
-    if (type == TypeDesc::FLOAT) {
-        d.f32.resize(count);
-        pixels = d.f32.data();
-    } else if (type == TypeDesc::UINT32) {
-        d.u32.resize(count);
-        pixels = d.u32.data();
-    } else if (type == TypeDesc::UINT8) {
-        d.u8.resize(count);
-        pixels = d.u8.data();
-    } else {
-        if (err) *err = "cannot read image '" + path + "': unsupported pixel type " + d.pixelType;
-        return false;
-    }
-    if (!in->read_image(0, 0, 0, spec.nchannels, type, pixels)) {
-        if (err) *err = "cannot read image '" + path + "': " + in->geterror();
-        return false;
-    }
-    in->close();
-    *out = std::move(d);
     return true;
 }
 

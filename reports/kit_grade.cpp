@@ -12,7 +12,6 @@
 #include <set>
 #include <sstream>
 
-#include <OpenImageIO/imageio.h>
 
 #include "common/json_util.h"
 #include "reports/legend.h"
@@ -301,8 +300,8 @@ bool readCsvImage(const std::string &path, const std::string &shown, int W, int 
 
 // A PFM file (Paul Debevec's portable float map): "Pf" (one channel) or "PF" (three; the first is
 // used), the width and height, a scale whose sign gives the byte order (negative: little-endian),
-// then 32-bit floats row by row from the *bottom* row up. Read here rather than through
-// OpenImageIO, whose Debian build has no PFM writer and whose reader's row order is its own.
+// then 32-bit floats row by row from the *bottom* row up. Read here: PNG and EXR are read through
+// libpng and OpenEXR (readImage), and none of the libraries visaudit links reads PFM.
 bool readPfm(const std::string &path, const std::string &shown, int W, int H, Pixels *out, std::string *why) {
     std::ifstream f(path, std::ios::binary);
     std::string magic;
@@ -363,50 +362,32 @@ bool readStudentImage(const std::string &path, const std::string &shown, bool de
         *why = shown + ": a PNG holds integers; write the depth image as .exr, .pfm or .csv";
         return false;
     }
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) {
-        *why = shown + ": cannot be read as an image (" + OIIO::geterror() + ")";
+    ImageData im;
+    std::string e;
+    if (!readImage(path, &im, &e)) {
+        *why = shown + ": " + e;
         return false;
     }
-    const OIIO::ImageSpec &spec = in->spec();
-    if (spec.width != W || spec.height != H) {
-        *why = shown + " is " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + "; the view is " +
+    if (im.width != W || im.height != H) {
+        *why = shown + " is " + std::to_string(im.width) + "x" + std::to_string(im.height) + "; the view is " +
                std::to_string(W) + "x" + std::to_string(H);
         return false;
     }
-    if (ext == ".png" && spec.nchannels != 1) {
-        *why = shown + ": " + std::to_string(spec.nchannels) + " channels; write a one-channel (grayscale) PNG";
+    if (ext == ".png" && im.channels() != 1) {
+        *why = shown + ": " + std::to_string(im.channels()) + " channels; write a one-channel (grayscale) PNG";
         return false;
     }
-    const OIIO::TypeDesc native = spec.format;
-    const size_t n = size_t(W) * size_t(H);
+    // The first channel, integers in their own type.
+    const size_t n = size_t(W) * size_t(H), C = size_t(im.channels());
     Pixels px;
     px.width = W;
     px.height = H;
     px.v.resize(n);
-    bool ok = false;
-    // Integers are read in their own type (OpenImageIO would scale them to [0, 1] as floats).
-    if (native == OIIO::TypeDesc::UINT8) {
-        std::vector<uint8_t> u(n);
-        ok = in->read_image(0, 0, 0, 1, native, u.data());
-        for (size_t i = 0; i < n; ++i) px.v[i] = u[i];
-    } else if (native == OIIO::TypeDesc::UINT16) {
-        std::vector<uint16_t> u(n);
-        ok = in->read_image(0, 0, 0, 1, native, u.data());
-        for (size_t i = 0; i < n; ++i) px.v[i] = u[i];
-    } else if (native == OIIO::TypeDesc::UINT32) {
-        std::vector<uint32_t> u(n);
-        ok = in->read_image(0, 0, 0, 1, native, u.data());
-        for (size_t i = 0; i < n; ++i) px.v[i] = u[i];
-    } else {
-        std::vector<float> f(n);
-        ok = in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, f.data());
-        for (size_t i = 0; i < n; ++i) px.v[i] = f[i];
-    }
-    if (!ok) {
-        *why = shown + ": cannot be read (" + in->geterror() + ")";
-        return false;
-    }
+    for (size_t i = 0; i < n; ++i)
+        px.v[i] = !im.u8.empty() ? double(im.u8[i * C])
+                  : !im.u16.empty() ? double(im.u16[i * C])
+                  : !im.u32.empty() ? double(im.u32[i * C])
+                                    : double(im.f32[i * C]);
     *out = std::move(px);
     return true;
 }

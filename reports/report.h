@@ -80,10 +80,6 @@ ViewImageNames viewImageNames(const std::string &baseName);
 std::string shadowImageName(const ViewImageNames &names, size_t light, const ViewResult &view);
 
 // ---- Images ------------------------------------------------------------------------------------
-// The threads OpenImageIO's readers may use (as --threads: 0 = every core); without it its EXR
-// reader runs a pool as large as the machine even for --threads 1. (Images are written without
-// OpenImageIO, each in the calling thread.)
-void setImageThreads(int threads);
 // Writes BASE.depth.exr, BASE.depth.png, BASE.overdraw.png and BASE.ids.exr for one view into dir
 // (writeFileAtomic: in place inside a report's staging folder, elsewhere a temporary name renamed).
 // Needs view.buffer (width x height). On failure returns false with the path and the reason.
@@ -95,15 +91,18 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, std::string
 // Every view's images with the names imageBaseNames gives (the names report.json lists).
 bool writeAllViewImages(const AnalysisResult &result, const std::string &dir, std::string *err);
 
-// An image read back as stored (for tests and golden-image comparison). Exactly one pixel vector
-// is filled, the one matching the file's pixel type; channels are interleaved, rows top-down.
+// An image read back as stored (for tests, golden-image comparison, level maps and grading): a PNG
+// (8- or 16-bit; a palette as RGB) or an OpenEXR file (every channel in the first one's type; R, G,
+// B, A first), told apart by their signatures (reports/image_read.cpp). Exactly one pixel vector
+// is filled, the one matching the pixel type; channels are interleaved, rows top-down.
 struct ImageData {
     int width = 0, height = 0;
     std::vector<std::string> channelNames;
-    std::string pixelType;       // OpenImageIO TypeDesc name: "float", "uint" (32-bit), "uint8"
+    std::string pixelType;       // "float", "uint" (32-bit), "uint8", "uint16" (OpenImageIO's names)
     std::vector<float> f32;      // pixelType "float"
     std::vector<uint32_t> u32;   // pixelType "uint"
     std::vector<uint8_t> u8;     // pixelType "uint8"
+    std::vector<uint16_t> u16;   // pixelType "uint16"
     int channels() const { return int(channelNames.size()); }
 };
 bool readImage(const std::string &path, ImageData *out, std::string *err);
