@@ -18,7 +18,6 @@
 #include <set>
 #include <sstream>
 
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "analysis/kit.h"
@@ -26,6 +25,7 @@
 #include "analysis/pipeline.h"
 #include "reports/kit_grade.h"
 #include "reports/report.h"
+#include "tests/image_files.h"
 #include "tests/run_binary.h"
 #include "tests/temp_dir_test.h"
 
@@ -291,11 +291,7 @@ bool cover(const json &xy, int W, int H, bool invertFill, bool *front, Frag &&fr
 
 void writeGray16(const fs::path &p, int W, int H, const std::vector<uint32_t> &ids) {
     std::vector<uint16_t> v(ids.begin(), ids.end());
-    auto out = OIIO::ImageOutput::create(p.string());
-    ASSERT_TRUE(out);
-    ASSERT_TRUE(out->open(p.string(), OIIO::ImageSpec(W, H, 1, OIIO::TypeDesc::UINT16)));
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT16, v.data()));
-    out->close();
+    ASSERT_TRUE(va::test::writePngFile(p.string(), W, H, 1, 16, v.data())) << p;
 }
 // A PFM: "Pf", the size, -1 (little-endian), then the rows from the bottom one up.
 void writePfm(const fs::path &p, int W, int H, const std::vector<float> &v) {
@@ -687,12 +683,13 @@ class BadSubmission : public Assignment {
 TEST_F(BadSubmission, EveryImageFormatGradesTheSame) {
     const fs::path d = copy("formats");
     auto readIds = [](const fs::path &png, std::vector<float> *v, int *W, int *H) {
-        auto in = OIIO::ImageInput::open(png.string());
-        ASSERT_TRUE(in);
-        *W = in->spec().width, *H = in->spec().height;
-        std::vector<uint16_t> u(size_t(*W) * size_t(*H));
-        ASSERT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT16, u.data()));
-        v->assign(u.begin(), u.end());
+        ImageData im;
+        std::string err;
+        ASSERT_TRUE(readImage(png.string(), &im, &err)) << err;
+        ASSERT_EQ(im.pixelType, "uint16");
+        ASSERT_EQ(im.channels(), 1);
+        *W = im.width, *H = im.height;
+        v->assign(im.u16.begin(), im.u16.end());
     };
     auto csv = [](const fs::path &p, int W, const std::vector<float> &v) {
         std::ofstream f(p);
@@ -719,15 +716,9 @@ TEST_F(BadSubmission, EveryImageFormatGradesTheSame) {
     csv(d / "spawn.ids.csv", W, spawnIds);
     csv(d / "spawn.depth.csv", W, readPfm(d / "spawn.depth.pfm", W, H));
     {
-        auto out = OIIO::ImageOutput::create((d / "top.ids.exr").string());
-        ASSERT_TRUE(out->open((d / "top.ids.exr").string(), OIIO::ImageSpec(TW, TH, 1, OIIO::TypeDesc::FLOAT)));
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, topIds.data()));
-        out->close();
+        ASSERT_TRUE(va::test::writeExrFile((d / "top.ids.exr").string(), TW, TH, {"Y"}, Imf::FLOAT, topIds.data()));
         const std::vector<float> depth = readPfm(d / "top.depth.pfm", TW, TH);
-        auto out2 = OIIO::ImageOutput::create((d / "top.depth.exr").string());
-        ASSERT_TRUE(out2->open((d / "top.depth.exr").string(), OIIO::ImageSpec(TW, TH, 1, OIIO::TypeDesc::FLOAT)));
-        ASSERT_TRUE(out2->write_image(OIIO::TypeDesc::FLOAT, depth.data()));
-        out2->close();
+        ASSERT_TRUE(va::test::writeExrFile((d / "top.depth.exr").string(), TW, TH, {"Y"}, Imf::FLOAT, depth.data()));
     }
     edit(d, [](json &j) {
         j["views"]["spawn"]["zbuffer"]["ids"] = "spawn.ids.csv";
@@ -789,10 +780,7 @@ TEST_F(BadSubmission, BadImagesAndListsAreNamedFailures) {
     writeGray16(d / "small.png", 10, 10, small);
     {
         std::vector<uint8_t> rgb(96 * 54 * 3, 0);
-        auto out = OIIO::ImageOutput::create((d / "rgb.png").string());
-        ASSERT_TRUE(out->open((d / "rgb.png").string(), OIIO::ImageSpec(96, 54, 3, OIIO::TypeDesc::UINT8)));
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, rgb.data()));
-        out->close();
+        ASSERT_TRUE(va::test::writePngFile((d / "rgb.png").string(), 96, 54, 3, 8, rgb.data()));
     }
     std::vector<float> nan(64 * 64, 1.0f);
     nan[64 * 5 + 7] = NAN;

@@ -1,6 +1,6 @@
 // The depth-format audit (analysis/audits/depth_audit.h), its table and JSON, and its plot: hand-computed
 // resolutions, exact distinct-value counts, inverse round trips over wide magnitudes, fight
-// predicates and onsets against analytic bounds, bad input, and the PNG read back through OIIO.
+// predicates and onsets against analytic bounds, bad input, and the PNG read back (readImage).
 #include <gtest/gtest.h>
 
 #include <unistd.h>

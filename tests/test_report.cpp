@@ -1,5 +1,5 @@
 // report.json against docs/report-schema.json, exact JSON values of a synthetic result, image
-// files read back through OpenImageIO, the bitmap font and the console funnel table.
+// files read back (readImage), the bitmap font and the console funnel table.
 #include <gtest/gtest.h>
 #include <png.h>
 #include <zlib.h>
