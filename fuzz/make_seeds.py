@@ -3,8 +3,10 @@
 map of tests/test_bsp.cpp, byte for byte), .pk3 archives holding it, and GLB files made from
 glTF files. Usage: make_seeds.py OUT_DIR [GLTF ...] -- writes OUT_DIR/bsp/tiny.bsp,
 OUT_DIR/pk3/tiny-{deflated,stored}.pk3 and OUT_DIR/glb/NAME.glb for every GLTF (its buffers,
-embedded as data: URIs or files next to it, become the GLB's binary chunk)."""
-import base64, json, os, struct, sys, zipfile
+embedded as data: URIs or files next to it, become the GLB's binary chunk), and OUT_DIR/image/:
+small PNGs (gray, gray + alpha, RGB, RGBA, palette; 8 and 16 bits) and uncompressed scanline EXRs
+(float, half and uint channels, a data window off the origin) for readImage."""
+import base64, json, os, struct, sys, zipfile, zlib
 
 L_ENT, L_SHD, L_PLN, L_NOD, L_LEF, L_LFC, L_LBR, L_MOD, L_BRU, L_BSD, L_VTX, L_MSV, L_EFF, L_FAC, L_LMP, L_LVL, L_VIS = range(17)
 
@@ -133,8 +135,61 @@ def glb_from_gltf(path):
     return struct.pack('<III', 0x46546C67, 2, 12 + len(chunks)) + chunks
 
 
+def png(w, h, color_type, depth, rows, palette=None):
+    """A PNG: IHDR, optional PLTE, one zlib IDAT of the rows (filter byte 0 each), IEND."""
+    def chunk(kind, data):
+        return struct.pack('>I', len(data)) + kind + data + struct.pack('>I', zlib.crc32(kind + data))
+    raw = b''.join(b'\0' + r for r in rows)
+    out = b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, depth, color_type, 0, 0, 0))
+    if palette:
+        out += chunk(b'PLTE', palette)
+    return out + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b'')
+
+
+def exr(w, h, channels, x0=0, y0=0):
+    """An OpenEXR file, scanlines without compression: channels [(name, type 0 uint/1 half/2 float)],
+    samples counting up; the data window's corner at (x0, y0)."""
+    def attr(name, kind, value):
+        return name.encode() + b'\0' + kind.encode() + b'\0' + struct.pack('<i', len(value)) + value
+    chans = sorted(channels)
+    chlist = b''.join(n.encode() + b'\0' + struct.pack('<iBxxxii', t, 0, 1, 1) for n, t in chans) + b'\0'
+    box = struct.pack('<iiii', x0, y0, x0 + w - 1, y0 + h - 1)
+    header = (b'\x76\x2f\x31\x01' + struct.pack('<I', 2) + attr('channels', 'chlist', chlist) +
+              attr('compression', 'compression', b'\0') + attr('dataWindow', 'box2i', box) +
+              attr('displayWindow', 'box2i', box) + attr('lineOrder', 'lineOrder', b'\0') +
+              attr('pixelAspectRatio', 'float', struct.pack('<f', 1)) +
+              attr('screenWindowCenter', 'v2f', struct.pack('<ff', 0, 0)) +
+              attr('screenWindowWidth', 'float', struct.pack('<f', 1)) + b'\0')
+    fmt = {0: '<I', 1: '<e', 2: '<f'}
+    lines = []
+    for y in range(h):
+        data = b''.join(struct.pack(fmt[t], (y * w + x) % 7 + 1) for _, t in chans for x in range(w))
+        lines.append(struct.pack('<ii', y0 + y, len(data)) + data)
+    offsets, at = [], len(header) + 8 * h
+    for l in lines:
+        offsets.append(at)
+        at += len(l)
+    return header + b''.join(struct.pack('<Q', o) for o in offsets) + b''.join(lines)
+
+
+def image_seeds(out):
+    d = os.path.join(out, 'image')
+    os.makedirs(d, exist_ok=True)
+    w, h = 5, 3
+    for name, ct, depth, ch in (('gray8', 0, 8, 1), ('grayalpha8', 4, 8, 2), ('rgb8', 2, 8, 3), ('rgba8', 6, 8, 4),
+                                ('gray16', 0, 16, 1), ('rgb16', 2, 16, 3)):
+        rows = [bytes((x * 37 + y * 11) & 0xFF for x in range(w * ch * depth // 8)) for y in range(h)]
+        open(os.path.join(d, name + '.png'), 'wb').write(png(w, h, ct, depth, rows))
+    rows = [bytes((x + y) % 3 for x in range(w)) for y in range(h)]
+    open(os.path.join(d, 'palette.png'), 'wb').write(png(w, h, 3, 8, rows, bytes(range(9))))
+    open(os.path.join(d, 'depth.exr'), 'wb').write(exr(w, h, [('Z', 2)]))
+    open(os.path.join(d, 'ids.exr'), 'wb').write(exr(w, h, [('id', 0)]))
+    open(os.path.join(d, 'rgba-half.exr'), 'wb').write(exr(w, h, [('R', 1), ('G', 1), ('B', 1), ('A', 1)], 2, -1))
+
+
 def main():
     out = sys.argv[1]
+    image_seeds(out)
     for d in ('bsp', 'pk3', 'glb'):
         os.makedirs(os.path.join(out, d), exist_ok=True)
     bsp = tiny_bsp()

@@ -24,9 +24,10 @@ namespace va {
 
 namespace {
 
-// The most pixels read (16,384 x 8,192): a header claiming more is refused before anything is
-// allocated for it (a damaged or hostile file must not take the machine's memory).
-constexpr uint64_t kMaxPixels = uint64_t(1) << 27;
+// The most pixels read (16,384 x 8,192) and samples (pixels x channels: 1 GiB of floats): a header
+// claiming more is refused before anything is allocated for it (a damaged or hostile file must not
+// take the machine's memory).
+constexpr uint64_t kMaxPixels = uint64_t(1) << 27, kMaxSamples = uint64_t(1) << 28;
 
 // libpng's errors: the message is kept and libpng's jump taken (to the setjmp in readPng).
 struct PngErrors {
@@ -121,6 +122,11 @@ bool readExr(const std::string &path, ImageData *d, std::string *err) {
             if (std::find(names.begin(), names.end(), c.name()) == names.end()) names.push_back(c.name());
         if (names.empty()) {
             *err = "cannot read image '" + path + "': it has no channels";
+            return false;
+        }
+        if (uint64_t(w) * uint64_t(h) * names.size() > kMaxSamples) {
+            *err = "cannot read image '" + path + "': its " + std::to_string(names.size()) +
+                   " channels of that many pixels are more than 2^28 samples, more than visaudit reads";
             return false;
         }
         const Imf::PixelType type = header.channels().findChannel(names[0])->type == Imf::UINT ? Imf::UINT : Imf::FLOAT;

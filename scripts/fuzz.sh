@@ -10,7 +10,7 @@
 #       CI's check: N executions per target (default 3000) mutating the small seeds only (no data/,
 #       no saved corpus); exits non-zero on any finding.
 #
-# Targets: scene_json views_json route_json budget_json obj ply off stl gltf glb bsp pk3.
+# Targets: scene_json views_json route_json budget_json obj ply off stl gltf glb bsp pk3 image.
 # Findings (crash-*, leak-*, timeout-*, oom-*) are copied to fuzz/findings/TARGET/ with the log;
 # each becomes a fix in the loader and a literal case in tests/test_fuzz_regressions.cpp.
 # Needs clang-14 and libclang-rt-14-dev (scripts/install-deps.sh).
@@ -18,7 +18,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$root"
 
-ALL=(scene_json views_json route_json budget_json obj ply off stl gltf glb bsp pk3)
+ALL=(scene_json views_json route_json budget_json obj ply off stl gltf glb bsp pk3 image)
 seconds=600 smoke=0 runs=3000 parallel=1 build="$root/build-fuzz" targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
