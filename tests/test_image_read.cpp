@@ -6,33 +6,23 @@
 // a crash.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 
 #include <zlib.h>
 
 #include "reports/report.h"
 #include "tests/image_files.h"
+#include "tests/temp_dir_test.h"
 
 using namespace va;
 using namespace va::test;
-namespace fs = std::filesystem;
 
 namespace {
 
-struct ScratchDir {
-    std::string path;
-    ScratchDir() {
-        std::string t = (fs::temp_directory_path() / "visaudit-imageread-XXXXXX").string();
-        path = ::mkdtemp(t.data()) ? t : "";
-    }
-    ~ScratchDir() {
-        std::error_code ec;
-        if (!path.empty()) fs::remove_all(path, ec);
-    }
+class ImageRead : public va::testing_util::TempDirTest {
+  protected:
+    ImageRead() : TempDirTest("imageread") {}
+    std::string path(const std::string &name) const { return (dir_ / name).string(); }
 };
 
 // Deterministic samples: varied, so a swapped channel, row or byte shows.
@@ -57,14 +47,13 @@ ImageData read(const std::string &path) {
 
 }  // namespace
 
-TEST(ImageRead, PngsAsWritten) {
-    ScratchDir dir;
+TEST_F(ImageRead, PngsAsWritten) {
     const int W = 37, H = 23;  // odd sizes: no row happens to align
     const std::vector<std::string> names[5] = {{}, {"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
     for (int channels = 1; channels <= 4; ++channels) {
         SCOPED_TRACE(channels);
         const size_t n = size_t(W) * H * size_t(channels);
-        const std::string base = dir.path + "/c" + std::to_string(channels);
+        const std::string base = path("c") + std::to_string(channels);
         const std::vector<uint8_t> u8 = samples<uint8_t>(n, 7 + channels);
         const std::vector<uint16_t> u16 = samples<uint16_t>(n, 11 + channels);
         ASSERT_TRUE(writePngFile(base + "-8.png", W, H, channels, 8, u8.data()));
@@ -83,48 +72,47 @@ TEST(ImageRead, PngsAsWritten) {
     std::vector<uint8_t> few(size_t(W) * H * 3), many = samples<uint8_t>(size_t(W) * H * 3, 3);
     for (size_t i = 0; i < few.size(); ++i) few[i] = uint8_t((i / 3 % 5) * 40 + i % 3);
     std::string err;
-    ASSERT_TRUE(writePngRgb8(dir.path + "/palette.png", W, H, few.data(), &err)) << err;
-    ASSERT_TRUE(writePngRgb8(dir.path + "/rgb.png", W, H, many.data(), &err)) << err;
+    ASSERT_TRUE(writePngRgb8(path("palette.png"), W, H, few.data(), &err)) << err;
+    ASSERT_TRUE(writePngRgb8(path("rgb.png"), W, H, many.data(), &err)) << err;
     for (const auto &[name, rgb] : {std::pair{"palette.png", &few}, std::pair{"rgb.png", &many}}) {
-        const ImageData im = read(dir.path + "/" + name);
+        const ImageData im = read(path(name));
         EXPECT_EQ(im.channelNames, names[3]) << name;
         EXPECT_EQ(im.u8, *rgb) << name;  // a palette expanded to the pixels written
     }
 }
 
-TEST(ImageRead, ExrsAsWritten) {
-    ScratchDir dir;
+TEST_F(ImageRead, ExrsAsWritten) {
     const int W = 29, H = 17;
     const size_t n = size_t(W) * H;
     const std::vector<float> z = samples<float>(n, 1), rgba = samples<float>(4 * n, 3), mixed = samples<float>(5 * n, 4);
     const std::vector<uint32_t> id = samples<uint32_t>(n, 2);
-    ASSERT_TRUE(writeExrFile(dir.path + "/z.exr", W, H, {"Z"}, Imf::FLOAT, z.data()));
-    ASSERT_TRUE(writeExrFile(dir.path + "/id.exr", W, H, {"id"}, Imf::UINT, id.data()));
-    ASSERT_TRUE(writeExrFile(dir.path + "/rgba-half.exr", W, H, {"R", "G", "B", "A"}, Imf::HALF, rgba.data()));
+    ASSERT_TRUE(writeExrFile(path("z.exr"), W, H, {"Z"}, Imf::FLOAT, z.data()));
+    ASSERT_TRUE(writeExrFile(path("id.exr"), W, H, {"id"}, Imf::UINT, id.data()));
+    ASSERT_TRUE(writeExrFile(path("rgba-half.exr"), W, H, {"R", "G", "B", "A"}, Imf::HALF, rgba.data()));
     // Written as Z, A, B, G, R (the file keeps them alphabetically: A, B, G, R, Z), a data window
     // off the origin; read as R, G, B, A, Z.
-    ASSERT_TRUE(writeExrFile(dir.path + "/mixed.exr", W, H, {"Z", "A", "B", "G", "R"}, Imf::FLOAT, mixed.data(), 5, -3));
+    ASSERT_TRUE(writeExrFile(path("mixed.exr"), W, H, {"Z", "A", "B", "G", "R"}, Imf::FLOAT, mixed.data(), 5, -3));
     {
-        const ImageData im = read(dir.path + "/z.exr");
+        const ImageData im = read(path("z.exr"));
         EXPECT_EQ(im.channelNames, std::vector<std::string>{"Z"});
         EXPECT_EQ(im.pixelType, "float");
         EXPECT_EQ(im.f32, z);
     }
     {
-        const ImageData im = read(dir.path + "/id.exr");
+        const ImageData im = read(path("id.exr"));
         EXPECT_EQ(im.channelNames, std::vector<std::string>{"id"});
         EXPECT_EQ(im.pixelType, "uint");
         EXPECT_EQ(im.u32, id);
     }
     {
-        const ImageData im = read(dir.path + "/rgba-half.exr");
+        const ImageData im = read(path("rgba-half.exr"));
         EXPECT_EQ(im.channelNames, (std::vector<std::string>{"R", "G", "B", "A"}));
         EXPECT_EQ(im.pixelType, "float");
         ASSERT_EQ(im.f32.size(), rgba.size());
         for (size_t i = 0; i < rgba.size(); ++i) ASSERT_EQ(im.f32[i], float(half(rgba[i]))) << i;
     }
     {
-        const ImageData im = read(dir.path + "/mixed.exr");
+        const ImageData im = read(path("mixed.exr"));
         EXPECT_EQ(im.channelNames, (std::vector<std::string>{"R", "G", "B", "A", "Z"}));
         EXPECT_EQ(im.width, W);
         EXPECT_EQ(im.height, H);
@@ -135,16 +123,15 @@ TEST(ImageRead, ExrsAsWritten) {
     }
 }
 
-TEST(ImageRead, NotAnImageOrCutShortIsAMessage) {
-    ScratchDir dir;
+TEST_F(ImageRead, NotAnImageOrCutShortIsAMessage) {
     std::string err;
     ImageData im;
-    EXPECT_FALSE(readImage(dir.path + "/absent.png", &im, &err));
+    EXPECT_FALSE(readImage(path("absent.png"), &im, &err));
     EXPECT_NE(err.find("absent.png"), std::string::npos) << err;
     {
-        std::ofstream(dir.path + "/text.png") << "not an image at all\n";
+        std::ofstream(path("text.png")) << "not an image at all\n";
     }
-    EXPECT_FALSE(readImage(dir.path + "/text.png", &im, &err));
+    EXPECT_FALSE(readImage(path("text.png"), &im, &err));
     EXPECT_NE(err.find("neither a PNG nor an OpenEXR file"), std::string::npos) << err;
     // A PNG header claiming 60000 x 60000 pixels (and no data): refused before 3.6 GB are allocated.
     {
@@ -162,25 +149,25 @@ TEST(ImageRead, NotAnImageOrCutShortIsAMessage) {
         be32(png, 2);
         png += idat;
         be32(png, uint32_t(crc32(0, reinterpret_cast<const Bytef *>(idat.data()), uInt(idat.size()))));
-        std::ofstream(dir.path + "/huge.png", std::ios::binary) << png;
-        EXPECT_FALSE(readImage(dir.path + "/huge.png", &im, &err));
+        std::ofstream(path("huge.png"), std::ios::binary) << png;
+        EXPECT_FALSE(readImage(path("huge.png"), &im, &err));
         EXPECT_NE(err.find("2^27 pixels"), std::string::npos) << err;
     }
     // Every prefix of a real PNG and EXR: refused with the file's name, never a crash.
     const int W = 40, H = 30;
     std::vector<uint8_t> rgb = samples<uint8_t>(size_t(W) * H * 3, 9);
-    ASSERT_TRUE(writePngRgb8(dir.path + "/whole.png", W, H, rgb.data(), &err)) << err;
+    ASSERT_TRUE(writePngRgb8(path("whole.png"), W, H, rgb.data(), &err)) << err;
     const std::vector<float> z = samples<float>(size_t(W) * H, 5);
-    ASSERT_TRUE(writeExrFile(dir.path + "/whole.exr", W, H, {"Z"}, Imf::FLOAT, z.data()));
+    ASSERT_TRUE(writeExrFile(path("whole.exr"), W, H, {"Z"}, Imf::FLOAT, z.data()));
     for (const char *name : {"whole.png", "whole.exr"}) {
-        std::ifstream f(dir.path + "/" + name, std::ios::binary);
+        std::ifstream f(path(name), std::ios::binary);
         const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
         ASSERT_GT(bytes.size(), 100u);
         for (size_t cut = 0; cut < bytes.size(); cut += 1 + cut / 8) {
-            const std::string path = dir.path + "/cut-" + std::to_string(cut) + "-" + name;
-            std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(cut));
-            EXPECT_FALSE(readImage(path, &im, &err)) << path;
-            EXPECT_NE(err.find(path), std::string::npos) << err;
+            const std::string cutPath = path("cut-" + std::to_string(cut) + "-" + name);
+            std::ofstream(cutPath, std::ios::binary).write(bytes.data(), std::streamsize(cut));
+            EXPECT_FALSE(readImage(cutPath, &im, &err)) << cutPath;
+            EXPECT_NE(err.find(cutPath), std::string::npos) << err;
         }
     }
 }
