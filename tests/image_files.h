@@ -12,6 +12,7 @@
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
+#include <ImfTiledOutputFile.h>
 #include <png.h>
 
 namespace va::test {
@@ -44,9 +45,11 @@ inline bool writePngFile(const std::string &path, int width, int height, int cha
 }
 
 // Channels `names` of one type (Imf::UINT: uint32_t samples; HALF or FLOAT: float samples, stored as
-// half or float), ZIP compressed, the data window's top-left corner at (x0, y0).
+// half or float), ZIP compressed, the data window's top-left corner at (x0, y0); scanlines, or tiles
+// of tileWidth x tileHeight when those are positive.
 inline bool writeExrFile(const std::string &path, int width, int height, const std::vector<std::string> &names,
-                         Imf::PixelType type, const void *samples, int x0 = 0, int y0 = 0) {
+                         Imf::PixelType type, const void *samples, int x0 = 0, int y0 = 0, int tileWidth = 0,
+                         int tileHeight = 0) {
     try {
         Imf::Header header(Imath::Box2i({0, 0}, {width - 1, height - 1}),
                            Imath::Box2i({x0, y0}, {x0 + width - 1, y0 + height - 1}));
@@ -64,6 +67,13 @@ inline bool writeExrFile(const std::string &path, int width, int height, const s
         for (size_t c = 0; c < C; ++c)
             fb.insert(names[c], Imf::Slice(type, const_cast<char *>(base) + origin + ptrdiff_t(c * sample), xStride,
                                            yStride));
+        if (tileWidth > 0 && tileHeight > 0) {
+            header.setTileDescription(Imf::TileDescription(unsigned(tileWidth), unsigned(tileHeight), Imf::ONE_LEVEL));
+            Imf::TiledOutputFile file(path.c_str(), header);
+            file.setFrameBuffer(fb);
+            file.writeTiles(0, file.numXTiles() - 1, 0, file.numYTiles() - 1);
+            return true;
+        }
         Imf::OutputFile file(path.c_str(), header);
         file.setFrameBuffer(fb);
         file.writePixels(height);

@@ -1,9 +1,9 @@
 // readImage (reports/image_read.cpp: libpng and OpenEXR) against the samples written: PNGs of every
 // channel count in 8 and 16 bits, visaudit's own palette and RGB PNGs, EXRs of float, uint and half
-// channels, channels out of order and a data window off the origin. (It replaced OpenImageIO, and
-// its answers are OpenImageIO's for these files: the channel names, the first channel's type, every
-// channel in it.) And files that are no image, or a truncated one: a message naming the file, never
-// a crash.
+// channels, channels out of order, tiles, and a data window off the origin. (It replaced
+// OpenImageIO, and its answers are OpenImageIO's for these files: the channel names, the first
+// channel's type, every channel in it.) And files that are no image, or a truncated one: a message
+// naming the file, never a crash.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -84,7 +84,8 @@ TEST_F(ImageRead, PngsAsWritten) {
 TEST_F(ImageRead, ExrsAsWritten) {
     const int W = 29, H = 17;
     const size_t n = size_t(W) * H;
-    const std::vector<float> z = samples<float>(n, 1), rgba = samples<float>(4 * n, 3), mixed = samples<float>(5 * n, 4);
+    const std::vector<float> z = samples<float>(n, 1), rgba = samples<float>(4 * n, 3);
+    const std::vector<float> mixed = samples<float>(5 * n, 4);
     const std::vector<uint32_t> id = samples<uint32_t>(n, 2);
     ASSERT_TRUE(writeExrFile(path("z.exr"), W, H, {"Z"}, Imf::FLOAT, z.data()));
     ASSERT_TRUE(writeExrFile(path("id.exr"), W, H, {"id"}, Imf::UINT, id.data()));
@@ -92,10 +93,19 @@ TEST_F(ImageRead, ExrsAsWritten) {
     // Written as Z, A, B, G, R (the file keeps them alphabetically: A, B, G, R, Z), a data window
     // off the origin; read as R, G, B, A, Z.
     ASSERT_TRUE(writeExrFile(path("mixed.exr"), W, H, {"Z", "A", "B", "G", "R"}, Imf::FLOAT, mixed.data(), 5, -3));
+    // Tiles (16 x 8, the last ones partial) instead of scanlines, off the origin too.
+    ASSERT_TRUE(writeExrFile(path("tiled.exr"), W, H, {"Z"}, Imf::FLOAT, z.data(), -2, 7, 16, 8));
     {
         const ImageData im = read(path("z.exr"));
         EXPECT_EQ(im.channelNames, std::vector<std::string>{"Z"});
         EXPECT_EQ(im.pixelType, "float");
+        EXPECT_EQ(im.f32, z);
+    }
+    {
+        const ImageData im = read(path("tiled.exr"));
+        EXPECT_EQ(im.channelNames, std::vector<std::string>{"Z"});
+        EXPECT_EQ(im.width, W);
+        EXPECT_EQ(im.height, H);
         EXPECT_EQ(im.f32, z);
     }
     {
