@@ -45,7 +45,9 @@ void pngWarning(png_structp, png_const_charp) {}
 // OpenImageIO named them: Y, Y A, R G B, R G B A. libpng reports errors by longjmp to the setjmp
 // below: every object with a destructor is made before it (`d` is the caller's, `rows` sized only
 // after the header is read), and nothing after it is read back once the jump is taken.
-bool readPng(std::FILE *f, const std::string &path, ImageData *d, std::string *err) {
+// `fileSize` bounds what the file can hold: deflate encodes at most 1032 bytes per byte, so a header
+// claiming more image data than that is refused before anything is allocated for it.
+bool readPng(std::FILE *f, uint64_t fileSize, const std::string &path, ImageData *d, std::string *err) {
     PngErrors errors;
     std::vector<png_bytep> rows;
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &errors, pngError, pngWarning);
@@ -70,6 +72,10 @@ bool readPng(std::FILE *f, const std::string &path, ImageData *d, std::string *e
     if (colorType == PNG_COLOR_TYPE_GRAY && bitDepth < 8) png_set_expand_gray_1_2_4_to_8(png);
     if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
     if (bitDepth == 16) png_set_swap(png);  // big-endian in the file
+    // The filtered rows as stored (a filter byte each), before any expansion.
+    const uint64_t stored = uint64_t(png_get_image_height(png, info)) * (1 + png_get_rowbytes(png, info));
+    if (stored > 1032 * fileSize + 1024)
+        png_error(png, "its header claims more image data than a file of this size can hold (cut short?)");
     png_set_interlace_handling(png);
     png_read_update_info(png, info);
     const png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
@@ -168,6 +174,9 @@ bool readImage(const std::string &path, ImageData *out, std::string *err) {
         if (err) *err = "cannot read image '" + path + "': " + std::strerror(errno);
         return false;
     }
+    std::fseek(f.get(), 0, SEEK_END);
+    const long size = std::ftell(f.get());
+    std::rewind(f.get());
     unsigned char magic[8] = {};
     const size_t got = std::fread(magic, 1, sizeof magic, f.get());
     static const unsigned char pngMagic[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
@@ -176,7 +185,7 @@ bool readImage(const std::string &path, ImageData *out, std::string *err) {
     bool ok;
     if (got == 8 && std::memcmp(magic, pngMagic, 8) == 0) {
         std::rewind(f.get());
-        ok = readPng(f.get(), path, &d, &why);
+        ok = readPng(f.get(), uint64_t(std::max(size, 0L)), path, &d, &why);
     } else if (got >= 4 && std::memcmp(magic, exrMagic, 4) == 0) {
         ok = readExr(path, &d, &why);
     } else {
