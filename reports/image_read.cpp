@@ -29,12 +29,15 @@ namespace {
 // take the machine's memory).
 constexpr uint64_t kMaxPixels = uint64_t(1) << 27, kMaxSamples = uint64_t(1) << 28;
 
-// libpng's errors: the message is kept and libpng's jump taken (to the setjmp in readPng).
-struct PngErrors {
+// What readPng changes while libpng may jump back to its setjmp: the caller's, so that nothing of
+// readPng's own frame changes between the setjmp and a jump (such locals would be indeterminate
+// after it). libpng's errors keep their message here and take the jump.
+struct PngRead {
     char message[256] = "";
+    std::vector<png_bytep> rows;
 };
 [[noreturn]] void pngError(png_structp png, png_const_charp msg) {
-    auto *e = static_cast<PngErrors *>(png_get_error_ptr(png));
+    auto *e = static_cast<PngRead *>(png_get_error_ptr(png));
     std::snprintf(e->message, sizeof e->message, "%s", msg ? msg : "libpng error");
     png_longjmp(png, 1);
 }
@@ -43,14 +46,12 @@ void pngWarning(png_structp, png_const_charp) {}
 // 8- or 16-bit samples in the file's channels: a palette as RGB (RGBA with a transparency chunk),
 // gray below 8 bits scaled to 8, 16-bit samples in the machine's byte order. Channels are named as
 // OpenImageIO named them: Y, Y A, R G B, R G B A. libpng reports errors by longjmp to the setjmp
-// below: every object with a destructor is made before it (`d` is the caller's, `rows` sized only
-// after the header is read), and nothing after it is read back once the jump is taken.
-// `fileSize` bounds what the file can hold: deflate encodes at most 1032 bytes per byte, so a header
-// claiming more image data than that is refused before anything is allocated for it.
-bool readPng(std::FILE *f, uint64_t fileSize, const std::string &path, ImageData *d, std::string *err) {
-    PngErrors errors;
-    std::vector<png_bytep> rows;
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &errors, pngError, pngWarning);
+// below; what changes after it is the caller's (`d`, `state`). `fileSize` bounds what the file can
+// hold: deflate encodes at most 1032 bytes per byte, so a header claiming more image data than that
+// is refused before anything is allocated for it.
+bool readPng(std::FILE *f, uint64_t fileSize, const std::string &path, ImageData *d, PngRead *state,
+             std::string *err) {
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, state, pngError, pngWarning);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
     if (!png || !info) {
         png_destroy_read_struct(&png, &info, nullptr);
@@ -59,7 +60,7 @@ bool readPng(std::FILE *f, uint64_t fileSize, const std::string &path, ImageData
     }
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_read_struct(&png, &info, nullptr);
-        *err = "cannot read image '" + path + "': " + errors.message;
+        *err = "cannot read image '" + path + "': " + state->message;
         return false;
     }
     png_init_io(png, f);
@@ -99,9 +100,9 @@ bool readPng(std::FILE *f, uint64_t fileSize, const std::string &path, ImageData
     }
     const size_t rowBytes = size_t(w) * size_t(channels) * size_t(depth / 8);
     if (png_get_rowbytes(png, info) != rowBytes) png_error(png, "unexpected row size after expansion");
-    rows.resize(h);
-    for (png_uint_32 y = 0; y < h; ++y) rows[y] = base + size_t(y) * rowBytes;
-    png_read_image(png, rows.data());
+    state->rows.resize(h);
+    for (png_uint_32 y = 0; y < h; ++y) state->rows[y] = base + size_t(y) * rowBytes;
+    png_read_image(png, state->rows.data());
     png_read_end(png, nullptr);
     png_destroy_read_struct(&png, &info, nullptr);
     return true;
@@ -185,7 +186,8 @@ bool readImage(const std::string &path, ImageData *out, std::string *err) {
     bool ok;
     if (got == 8 && std::memcmp(magic, pngMagic, 8) == 0) {
         std::rewind(f.get());
-        ok = readPng(f.get(), uint64_t(std::max(size, 0L)), path, &d, &why);
+        PngRead state;
+        ok = readPng(f.get(), uint64_t(std::max(size, 0L)), path, &d, &state, &why);
     } else if (got >= 4 && std::memcmp(magic, exrMagic, 4) == 0) {
         ok = readExr(path, &d, &why);
     } else {
