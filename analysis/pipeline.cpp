@@ -408,9 +408,10 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     //   z-buffer key, id, depth, fragments, passes        4 + 4 + 8 + 2 + 2 = 20
     //   reference id, depth; culling fate                  4 + 8 + 1 = 13
     //   raycast id, depth (+ u, v with effects); disagreements   8 (+ 8) + 1
-    //   z-fighting: class, fight mask, hotspot ids (+ 2 nearest depths and triangles while it runs)
-    //     + the two-surface pixels' lists its thread keeps (pixel, two depths, fight mask, two
-    //     depth cells, an index: at most one entry per pixel)   9 + 24 + 36
+    //   z-fighting: class, fight mask, hotspot ids (+ 2 nearest depths and triangles while it runs:
+    //     a band of them from the reference's fragments, the whole view without)
+    //     + the two-surface pixels' lists its thread keeps (pixel, two depths, two triangles, fight
+    //     mask, two depth cells, an index: at most one entry per pixel)   9 + 24 + 44
     //   ordering: painter and BSP id + class, scanline id, per-order overdraw, A-buffer composite,
     //     edges, heads, lengths and center depth          5 + 5 + 4 + 8 + 4 + 24
     //   occlusion's pre-pass depth and Hi-Z pyramid (freed before the z-buffer)   not added
@@ -418,7 +419,7 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     uint64_t perPixel = 20 + 16;
     if (s.audit) perPixel += 13;
     if (s.raycast) perPixel += 17;  // + the cross-check's recast over the z-buffer's set (id, depth)
-    if (s.zfight) perPixel += 33 + 36;
+    if (s.zfight) perPixel += 33 + 44;
     const EffectPlan plan = planEffects(scene, s.effects);
     if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;
     if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) {

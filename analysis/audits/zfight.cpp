@@ -157,11 +157,12 @@ bool samePlane(const DepthPlane &a, const DepthPlane &b) {
            std::memcmp(&a.c, &b.c, sizeof a.c) == 0;
 }
 
-}  // namespace
-
-bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref, const ScreenTriangles &tris,
-                                 int width, int height, bool orthographic, const uint8_t *singleSided, TwoNearest &r,
-                                 const std::function<void(size_t, size_t)> &bandDone) {
+// findTwoNearestFromReference; with `bandLocal`, r holds one band at a time (pixel p of band
+// [p0, p1) at index p - p0, final when bandDone(p0, p1) is called): a band's state stays in the
+// core's cache instead of streaming a whole view's (48 MB at 1080p) through memory.
+bool twoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref, const ScreenTriangles &tris, int width,
+                             int height, bool orthographic, const uint8_t *singleSided, TwoNearest &r, bool bandLocal,
+                             const std::function<void(size_t, size_t)> &bandDone) {
     const FragmentCache &cache = ref.fragmentCache;
     const ScreenTriangles &rs = ref.screen;
     if (!cache.complete() || cache.begin.size() != rs.size() + 1 || ref.width != width || ref.height != height)
@@ -170,10 +171,11 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
     r.height = std::max(height, 0);
     const size_t W = size_t(r.width), n = W * size_t(r.height);
     // Every pixel is set band by band below.
-    r.depth1.resize(n);
-    r.depth2.resize(n);
-    r.screen1.resize(n);
-    r.screen2.resize(n);
+    const size_t held = bandLocal ? std::min(n, kFragmentBandRows * W) : n;
+    r.depth1.resize(held);
+    r.depth2.resize(held);
+    r.screen1.resize(held);
+    r.screen2.resize(held);
     if (n == 0) return true;
 
     // Per source triangle, its first screen triangle in the reference (a source's pieces are
@@ -241,21 +243,30 @@ bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &
     }, bandBegin, bandRuns);
     for (size_t b = 0; b < bands; ++b) {
         const size_t p0 = b * bandPixels, p1 = std::min(p0 + bandPixels, n);
-        std::fill(r.depth1.begin() + p0, r.depth1.begin() + p1, kInf);
-        std::fill(r.depth2.begin() + p0, r.depth2.begin() + p1, kInf);
-        std::fill(r.screen1.begin() + p0, r.screen1.begin() + p1, kNoFragment);
-        std::fill(r.screen2.begin() + p0, r.screen2.begin() + p1, kNoFragment);
+        const size_t base = bandLocal ? p0 : 0;  // r's index of pixel p: p - base
+        std::fill(r.depth1.begin() + ptrdiff_t(p0 - base), r.depth1.begin() + ptrdiff_t(p1 - base), kInf);
+        std::fill(r.depth2.begin() + ptrdiff_t(p0 - base), r.depth2.begin() + ptrdiff_t(p1 - base), kInf);
+        std::fill(r.screen1.begin() + ptrdiff_t(p0 - base), r.screen1.begin() + ptrdiff_t(p1 - base), kNoFragment);
+        std::fill(r.screen2.begin() + ptrdiff_t(p0 - base), r.screen2.begin() + ptrdiff_t(p1 - base), kNoFragment);
         for (uint32_t k = bandBegin[b]; k < bandBegin[b + 1]; ++k) {
             Run &u = runs[bandRuns[k]];
             const uint32_t *pixelOf = pixelsOf(u);
             const double *depthOf = u.side ? walked.depth.data() : cache.depth.data();
             uint64_t f = u.at;
-            for (; f < u.end && pixelOf[f] < p1; ++f) keepTwoNearest(r, pixelOf[f], u.tri, u.first, depthOf[f]);
+            for (; f < u.end && pixelOf[f] < p1; ++f) keepTwoNearest(r, pixelOf[f] - base, u.tri, u.first, depthOf[f]);
             u.at = f;
         }
         if (bandDone) bandDone(p0, p1);
     }
     return true;
+}
+
+}  // namespace
+
+bool findTwoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref, const ScreenTriangles &tris,
+                                 int width, int height, bool orthographic, const uint8_t *singleSided, TwoNearest &r,
+                                 const std::function<void(size_t, size_t)> &bandDone) {
+    return twoNearestFromReference(scene, ref, tris, width, height, orthographic, singleSided, r, false, bandDone);
 }
 
 // ---- Triangle pairs: common vertices, shared edge, coplanarity --------------------------------
@@ -667,18 +678,24 @@ uint32_t FightFilter::cell(double d) const {
 
 namespace {
 
-// The pixels with two surfaces that may fight as lists (pixel, nearer depth, farther depth), the
-// range of the depths of the pixels with one surface, and the counts; gathered a stretch of pixels
-// at a time (the thread's storage, kept from view to view: only the first n entries are this
-// view's). A pixel the filter decides cannot fight in any format (2a) is counted, not listed;
-// every two-surface pixel is listed when a format is not filtered.
+// The pixels with two surfaces that may fight as lists (pixel, nearer and farther depth and screen
+// triangle, ascending in pixel), the range of the depths of the pixels with one surface, those of
+// their depths outside some format's valid range, and the counts; gathered a stretch of pixels at a
+// time (the thread's storage, kept from view to view: only the first n entries are this view's).
+// A pixel the filter decides cannot fight in any format (2a) is counted, not listed; every
+// two-surface pixel is listed when a format is not filtered. Everything after the gathering reads
+// the lists, so the two nearest surfaces need to be held only a band at a time.
 struct TwoSurfaces {
     std::vector<uint32_t> pixel;
     std::vector<double> near1, near2;
+    std::vector<uint32_t> screen1, screen2;
     size_t n = 0;        // listed
     uint64_t two = 0;    // pixels with two surfaces (listed or not)
     double oneMin = kInf, oneMax = -kInf;
     bool oneUnordered = false;  // a NaN depth: decided pixel by pixel
+    // The one-surface depths outside [validLo, validHi], the range valid in every format (in that
+    // range no format clamps, FilterForView): the only ones markFights may need to encode.
+    std::vector<double> oneOutside;
     uint64_t covered = 0;  // pixels with a surface
 
     void clear() {
@@ -686,45 +703,57 @@ struct TwoSurfaces {
         two = 0;
         oneMin = kInf, oneMax = -kInf;
         oneUnordered = false;
+        oneOutside.clear();
         covered = 0;
     }
-    // Pixels [p0, p1) of `two`, after those gathered before.
-    void gather(const TwoNearest &twoNearest, const FightFilter &filter, size_t p0, size_t p1) {
+    // Pixels [p0, p1) of the view, after those gathered before; `twoNearest` holds pixel p at
+    // p - base. [validLo, validHi]: FilterForView's.
+    void gather(const TwoNearest &twoNearest, size_t base, const FightFilter &filter, double validLo, double validHi,
+                size_t p0, size_t p1) {
         const bool listAll = !filter.filteredAll();
         const uint32_t *s1 = twoNearest.screen1.data(), *s2 = twoNearest.screen2.data();
         const double *d1s = twoNearest.depth1.data(), *d2s = twoNearest.depth2.data();
+        const size_t viewPixels = size_t(twoNearest.width) * size_t(twoNearest.height);
         uint64_t cov = 0, pairs = 0;
         double lo = oneMin, hi = oneMax;
         bool unordered = oneUnordered;
         for (size_t p = p0; p < p1; ++p) {
-            if (s1[p] == kNoFragment) continue;
+            const size_t i = p - base;
+            if (s1[i] == kNoFragment) continue;
             ++cov;
-            const double d1 = d1s[p];
-            if (s2[p] != kNoFragment) {
+            const double d1 = d1s[i];
+            if (s2[i] != kNoFragment) {
                 ++pairs;
-                const double d2 = d2s[p];
+                const double d2 = d2s[i];
                 if (!listAll && filter.cannotFightAny(filter.cell(d1), filter.cell(d2))) continue;
                 if (n == pixel.size()) {
                     // Grown by half, never beyond the view's pixels (estimateMemory's bound).
-                    const size_t size = std::min(std::max<size_t>(n + 1024, n + n / 2), twoNearest.pixels());
+                    const size_t size = std::min(std::max<size_t>(n + 1024, n + n / 2), viewPixels);
                     pixel.resize(size);
                     near1.resize(size);
                     near2.resize(size);
+                    screen1.resize(size);
+                    screen2.resize(size);
                 }
                 pixel[n] = uint32_t(p);
                 near1[n] = d1;
                 near2[n] = d2;
+                screen1[n] = s1[i];
+                screen2[n] = s2[i];
                 ++n;
             } else {
                 lo = std::min(lo, d1);
                 hi = std::max(hi, d1);
                 unordered |= d1 != d1;
+                if (!(d1 >= validLo && d1 <= validHi)) oneOutside.push_back(d1);
             }
         }
         covered += cov;
         two += pairs;
         oneMin = lo, oneMax = hi, oneUnordered = unordered;
     }
+    // The listed entry of pixel p (listed: the fighting pixels are).
+    size_t entryOf(size_t p) const { return size_t(std::lower_bound(pixel.begin(), pixel.begin() + ptrdiff_t(n), uint32_t(p)) - pixel.begin()); }
 };
 
 // 2a's cells over the camera's depth range [near, far] (what the clip keeps; a depth outside is never
@@ -735,6 +764,8 @@ struct FilterForView {
     std::vector<DepthFormatSpec> formats;
     std::vector<DepthEncoder> enc;
     std::optional<FightFilter> filter;
+    // The depths every format stores unclamped: [max minValidDepth, min far] over the encoders.
+    double validLo = -kInf, validHi = kInf;
 
     const FightFilter &get(const Camera &cam, const std::vector<DepthFormatSpec> &specs) {
         if (filter && doubleBits(nearZ) == doubleBits(cam.nearZ) && doubleBits(farZ) == doubleBits(cam.farZ) &&
@@ -742,7 +773,12 @@ struct FilterForView {
             return *filter;
         nearZ = cam.nearZ, farZ = cam.farZ, formats = specs;
         enc.resize(specs.size());
-        for (size_t i = 0; i < specs.size(); ++i) enc[i] = makeDepthEncoder(specs[i], cam.nearZ, cam.farZ);
+        validLo = -kInf, validHi = kInf;
+        for (size_t i = 0; i < specs.size(); ++i) {
+            enc[i] = makeDepthEncoder(specs[i], cam.nearZ, cam.farZ);
+            validLo = std::max(validLo, enc[i].minValidDepth);
+            validHi = std::min(validHi, enc[i].farZ);
+        }
         filter.emplace(enc, cam.nearZ, cam.farZ);
         return *filter;
     }
@@ -756,9 +792,8 @@ struct FilterForView {
 //    clamps d into [minValidDepth, hi] with hi = far or +inf, render/depth_format_impl.h), which the
 //    one-surface depths' range decides for all of them at once, per format; otherwise they are
 //    encoded one by one.
-void markFights(const TwoNearest &two, const TwoSurfaces &lists, const FilterForView &view,
-                const ZFightSettings &settings, ZFightResult &r) {
-    const size_t N = two.pixels(), F = settings.formats.size();
+void markFights(const TwoSurfaces &lists, const FilterForView &view, const ZFightSettings &settings, ZFightResult &r) {
+    const size_t F = settings.formats.size();
     const std::vector<uint32_t> &pixel = lists.pixel;
     const std::vector<double> &near1 = lists.near1, &near2 = lists.near2;
     const size_t n2 = lists.n;
@@ -791,9 +826,8 @@ void markFights(const TwoNearest &two, const TwoSurfaces &lists, const FilterFor
                 oor += (o1 || o2) ? 1 : 0;
             }
             if (oneInRange) return;
-            for (size_t p = 0; p < N; ++p) {
-                if (two.screen1[p] == kNoFragment || two.screen2[p] != kNoFragment) continue;
-                const double d1 = two.depth1[p];
+            // The one-surface depths in every format's range are in this one's.
+            for (const double d1 : lists.oneOutside) {
                 if (d1 >= lo && d1 <= hi) continue;
                 uint32_t k1 = 0;
                 bool o1 = false;
@@ -809,52 +843,53 @@ void markFights(const TwoNearest &two, const TwoSurfaces &lists, const FilterFor
 // 3. Classify the pixels that fight somewhere: shared_edge, then intersection (never for coplanar
 //    triangles: they have no intersection line), then coplanar, else separated. Returns the smallest
 //    d2 - d1 over separated fighting pixels (for the recommendation's text).
-double classifyFights(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoNearest &two,
+//    The fighting pixels are listed (markFights), so the lists are read in their (scan) order.
+double classifyFights(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoSurfaces &lists,
                       const ZFightSettings &settings, ZFightResult &r) {
-    const int W = r.width, H = r.height;
+    const size_t W = size_t(r.width);
     const size_t F = settings.formats.size();
     PairCache pairs{scene, cam, {}};
     double minSeparatedGap = kInf;  // smallest d2 - d1 over separated fighting pixels (for the text)
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            const size_t p = size_t(y) * size_t(W) + size_t(x);
-            const uint32_t mask = r.fightMask[p];
-            if (!mask) continue;
-            const uint32_t t1 = two.screen1[p], t2 = two.screen2[p];
-            const uint32_t s1 = tris.source[t1], s2 = tris.source[t2];
-            const PairInfo &info = pairs.get(s1, s2);
-            ZPixelClass c = ZPixelClass::separated;
-            if (info.sharedEdge && info.edgeOnScreen &&
-                distanceToSegment(x + 0.5, y + 0.5, info.ex0, info.ey0, info.ex1, info.ey1) <=
-                    settings.sharedEdgePixels)
-                c = ZPixelClass::shared_edge;
-            else if (!info.coplanar && planesCrossInPixel(tris.planes[tris.plane[t1]], tris.planes[tris.plane[t2]], x,
-                                                          y, cam.orthographic))
-                c = ZPixelClass::intersection;
-            else if (info.coplanar)
-                c = ZPixelClass::coplanar;
-            r.pixelClass[p] = uint8_t(c);
-            if (c == ZPixelClass::separated) minSeparatedGap = std::min(minSeparatedGap, two.depth2[p] - two.depth1[p]);
-            ++r.fightingPixelsAnyFormat;
+    for (size_t k = 0; k < lists.n; ++k) {
+        const size_t p = lists.pixel[k];
+        const uint32_t mask = r.fightMask[p];
+        if (!mask) continue;
+        const int x = int(p % W), y = int(p / W);
+        const uint32_t t1 = lists.screen1[k], t2 = lists.screen2[k];
+        const uint32_t s1 = tris.source[t1], s2 = tris.source[t2];
+        const PairInfo &info = pairs.get(s1, s2);
+        ZPixelClass c = ZPixelClass::separated;
+        if (info.sharedEdge && info.edgeOnScreen &&
+            distanceToSegment(x + 0.5, y + 0.5, info.ex0, info.ey0, info.ex1, info.ey1) <=
+                settings.sharedEdgePixels)
+            c = ZPixelClass::shared_edge;
+        else if (!info.coplanar && planesCrossInPixel(tris.planes[tris.plane[t1]], tris.planes[tris.plane[t2]], x,
+                                                      y, cam.orthographic))
+            c = ZPixelClass::intersection;
+        else if (info.coplanar)
+            c = ZPixelClass::coplanar;
+        r.pixelClass[p] = uint8_t(c);
+        if (c == ZPixelClass::separated) minSeparatedGap = std::min(minSeparatedGap, lists.near2[k] - lists.near1[k]);
+        ++r.fightingPixelsAnyFormat;
+        switch (c) {
+        case ZPixelClass::separated: ++r.separatedPixels; break;
+        case ZPixelClass::coplanar: ++r.coplanarPixels; break;
+        case ZPixelClass::shared_edge: ++r.sharedEdgePixels; break;
+        case ZPixelClass::intersection: ++r.intersectionPixels; break;
+        case ZPixelClass::none: break;
+        }
+        for (size_t i = 0; i < F; ++i) {
+            if (!(mask >> i & 1)) continue;
+            ZFightFormatStats &st = r.perFormat[i];
             switch (c) {
-            case ZPixelClass::separated: ++r.separatedPixels; break;
-            case ZPixelClass::coplanar: ++r.coplanarPixels; break;
-            case ZPixelClass::shared_edge: ++r.sharedEdgePixels; break;
-            case ZPixelClass::intersection: ++r.intersectionPixels; break;
+            case ZPixelClass::coplanar: ++st.coplanarPixels; [[fallthrough]];
+            case ZPixelClass::separated: ++st.fightingPixels; break;
+            case ZPixelClass::shared_edge: ++st.sharedEdgePixels; break;
+            case ZPixelClass::intersection: ++st.intersectionPixels; break;
             case ZPixelClass::none: break;
             }
-            for (size_t i = 0; i < F; ++i) {
-                if (!(mask >> i & 1)) continue;
-                ZFightFormatStats &st = r.perFormat[i];
-                switch (c) {
-                case ZPixelClass::coplanar: ++st.coplanarPixels; [[fallthrough]];
-                case ZPixelClass::separated: ++st.fightingPixels; break;
-                case ZPixelClass::shared_edge: ++st.sharedEdgePixels; break;
-                case ZPixelClass::intersection: ++st.intersectionPixels; break;
-                case ZPixelClass::none: break;
-                }
-            }
         }
+    }
 
     return minSeparatedGap;
 }
@@ -862,10 +897,10 @@ double classifyFights(const Scene &scene, const Camera &cam, const ScreenTriangl
 // 4. Hotspots: 8-connected components of separated/coplanar fighting pixels, flood-filled from seeds
 //    in scan order (component k's seed is its first pixel in scan order); those of at least
 //    minHotspotArea pixels, area descending, ties by seed, each explained (6.).
-void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoNearest &two,
+void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoSurfaces &lists,
                   const ZFightSettings &settings, ZFightResult &r) {
     const int W = r.width, H = r.height;
-    const size_t N = two.pixels(), F = settings.formats.size();
+    const size_t N = size_t(W) * size_t(H), F = settings.formats.size();
     auto isHotspotPixel = [&](size_t p) {
         const auto c = ZPixelClass(r.pixelClass[p]);
         return c == ZPixelClass::separated || c == ZPixelClass::coplanar;
@@ -928,13 +963,14 @@ void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &
             const int x = int(p % size_t(W)), y = int(p / size_t(W));
             h.minX = std::min(h.minX, x), h.maxX = std::max(h.maxX, x);
             h.minY = std::min(h.minY, y), h.maxY = std::max(h.maxY, y);
-            const double d1 = two.depth1[p], d2 = two.depth2[p];
+            const size_t k = lists.entryOf(p);
+            const double d1 = lists.near1[k], d2 = lists.near2[k];
             sum = sum + worldPointAt(cam, x + 0.5, y + 0.5, d1);
             depths.push_back(d1);
             gaps.push_back(d2 - d1);  // >= 0: d1 <= d2 by construction
             h.depthGapMax = std::max(h.depthGapMax, d2 - d1);
             if (ZPixelClass(r.pixelClass[p]) == ZPixelClass::coplanar) ++h.coplanarPixels;
-            ++pairCount[PairCache::key(tris.source[two.screen1[p]], tris.source[two.screen2[p]])];
+            ++pairCount[PairCache::key(tris.source[lists.screen1[k]], tris.source[lists.screen2[k]])];
             for (size_t i = 0; i < F; ++i) cp.formatPixels[i] += r.fightMask[p] >> i & 1;
         }
         cp.area = members.size();
@@ -1033,25 +1069,27 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     }
 
     // 1. Two nearest surfaces.
-    // This thread's buffers, reused from view to view: a fresh 1080p set (48 MB) cost more in page
-    // faults than filling it.
+    // This thread's buffers, reused from view to view (fresh ones cost more in page faults than
+    // filling them). From the reference, the two nearest surfaces are held a band at a time.
     thread_local TwoNearest two;
     thread_local TwoSurfaces lists;
     thread_local FilterForView filter;
     const FightFilter &cells = filter.get(cam, settings.formats);
     lists.clear();
     if (!settings.reference ||
-        !findTwoNearestFromReference(scene, *settings.reference, tris, W, H, cam.orthographic, settings.singleSided, two,
-                                     [&](size_t p0, size_t p1) { lists.gather(two, cells, p0, p1); })) {
+        !twoNearestFromReference(scene, *settings.reference, tris, W, H, cam.orthographic, settings.singleSided, two, true,
+                                 [&](size_t p0, size_t p1) {
+                                     lists.gather(two, p0, cells, filter.validLo, filter.validHi, p0, p1);
+                                 })) {
         findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided, two);
-        lists.gather(two, cells, 0, N);
+        lists.gather(two, 0, cells, filter.validLo, filter.validHi, 0, N);
     }
     r.coveredPixels = lists.covered;
     r.twoSurfacePixels = lists.two;
 
-    markFights(two, lists, filter, settings, r);
-    const double minSeparatedGap = classifyFights(scene, cam, tris, two, settings, r);
-    findHotspots(scene, cam, tris, two, settings, r);
+    markFights(lists, filter, settings, r);
+    const double minSeparatedGap = classifyFights(scene, cam, tris, lists, settings, r);
+    findHotspots(scene, cam, tris, lists, settings, r);
     recommend(minSeparatedGap, r);
     return r;
 }
