@@ -44,7 +44,7 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     const int W = zf.width, H = zf.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
     if (W <= 0 || H <= 0 || zb.width != W || zb.height != H || zb.depth.size() != n || zf.pixelClass.size() != n ||
-        zf.hotspotOf.size() != n) {
+        zf.hotspotPixels.size() != zf.hotspotIds.size() || (!zf.hotspotPixels.empty() && zf.hotspotPixels.back() >= n)) {
         if (err)
             *err = "z-fighting image: the analysis (" + std::to_string(W) + "x" + std::to_string(H) +
                    ") and the z-buffer (" + std::to_string(zb.width) + "x" + std::to_string(zb.height) +
@@ -126,12 +126,11 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     std::vector<uint16_t> hotspotCode(zf.hotspots.size() + 1);
     for (size_t k = 1; k < hotspotCode.size(); ++k) hotspotCode[k] = img.codeOf(zfightHotspotColor(uint32_t(k)));
     const uint16_t other = img.codeOf(kZFightOtherHotspotColor);
-    for (int y = 0; y < H; ++y)
-        for (int xx = 0; xx < W; ++xx) {
-            const uint32_t id = zf.hotspotOf[size_t(y) * size_t(W) + size_t(xx)];
-            if (!id) continue;
-            img.code[size_t(y) * cw + size_t(xx)] = id < hotspotCode.size() ? hotspotCode[id] : other;
-        }
+    for (size_t k = 0; k < zf.hotspotPixels.size(); ++k) {
+        const size_t p = zf.hotspotPixels[k], y = p / size_t(W), xx = p % size_t(W);
+        const uint32_t id = zf.hotspotIds[k];
+        img.code[y * cw + xx] = id < hotspotCode.size() ? hotspotCode[id] : other;
+    }
 
     // 5. Legend.
     for (size_t i = 0; i < entries.size(); ++i) {

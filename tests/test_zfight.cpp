@@ -129,7 +129,7 @@ void expectConsistent(const ZFightResult &r) {
         EXPECT_FALSE(h.formats.empty());
         EXPECT_LE(h.pairPixels, h.area);
         uint64_t counted = 0;
-        for (uint32_t id : r.hotspotOf) counted += id == h.id;
+        for (uint32_t id : r.hotspotIds) counted += id == h.id;
         EXPECT_EQ(counted, h.area) << "hotspot " << h.id;
     }
 }
@@ -583,7 +583,7 @@ TEST(ZFightCases, ExactHotspotCountsAndEightConnectivity) {
     EXPECT_EQ(r9.hotspotCount, 2u);
     EXPECT_EQ(stats(r9, DepthFormat::unorm16).hotspots, 2u);
     EXPECT_EQ(stats(r9, DepthFormat::unorm16).fightingPixels, 85u);
-    EXPECT_EQ(r9.hotspotOf[size_t(20) * 64 + 40], 0u);
+    EXPECT_EQ(r9.hotspotAt(size_t(20) * 64 + 40), 0u);
     // Listing only one: all three counted, one described.
     s.minHotspotArea = 1;
     s.maxHotspotsListed = 1;
@@ -591,7 +591,7 @@ TEST(ZFightCases, ExactHotspotCountsAndEightConnectivity) {
     EXPECT_EQ(r1.hotspotCount, 3u);
     EXPECT_EQ(r1.hotspots.size(), 1u);
     EXPECT_EQ(stats(r1, DepthFormat::unorm16).hotspots, 3u);
-    EXPECT_EQ(r1.hotspotOf[size_t(20) * 64 + 40], 3u);  // ids also beyond the listed ones
+    EXPECT_EQ(r1.hotspotAt(size_t(20) * 64 + 40), 3u);  // ids also beyond the listed ones
 }
 
 TEST(ZFightCases, InterpenetratingTrianglesGiveAnIntersectionLineNotAHotspot) {
@@ -758,7 +758,7 @@ TEST(ZFightCases, FightBitsEqualEncodingEveryPixel) {
                         mask |= second && k1 >= k2 ? uint32_t(1) << i : 0;
                         oor[i] += o1 || o2;
                     }
-                    ASSERT_EQ(r.fightMask[p], mask) << what << " pixel " << p;
+                    ASSERT_EQ(r.fightMaskAt(p), mask) << what << " pixel " << p;
                     fighting += mask != 0;
                 }
                 EXPECT_EQ(r.twoSurfacePixels, twoSurfaces) << what;
@@ -868,7 +868,7 @@ TEST(ZFightDemo, CoplanarDecalIsAHotspotAtItsWorldPosition) {
         const bool aFloor = a < scene.sources[0].triangleCount, bFloor = b < scene.sources[0].triangleCount;
         if ((aDecal && bFloor) || (bDecal && aFloor)) {
             ++decalOverFloor;
-            EXPECT_EQ(r.hotspotOf[p], decal->id);
+            EXPECT_EQ(r.hotspotAt(p), decal->id);
         }
     }
     EXPECT_EQ(decal->area, decalOverFloor);

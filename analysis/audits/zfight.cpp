@@ -837,23 +837,26 @@ void markFights(const TwoSurfaces &lists, const FilterForView &view, const ZFigh
         });
         r.perFormat[i].outOfRangePixels = oor;
     }
-    for (size_t k = 0; k < n2; ++k) r.fightMask[pixel[k]] = mask[k];
+    r.fightPixels.clear();
+    r.fightMasks.clear();
+    for (size_t k = 0; k < n2; ++k)
+        if (mask[k]) r.fightPixels.push_back(pixel[k]), r.fightMasks.push_back(mask[k]);
 }
 
 // 3. Classify the pixels that fight somewhere: shared_edge, then intersection (never for coplanar
 //    triangles: they have no intersection line), then coplanar, else separated. Returns the smallest
 //    d2 - d1 over separated fighting pixels (for the recommendation's text).
-//    The fighting pixels are listed (markFights), so the lists are read in their (scan) order.
+//    The fighting pixels are r.fightPixels, in scan order, and in the lists (markFights).
 double classifyFights(const Scene &scene, const Camera &cam, const ScreenTriangles &tris, const TwoSurfaces &lists,
                       const ZFightSettings &settings, ZFightResult &r) {
     const size_t W = size_t(r.width);
     const size_t F = settings.formats.size();
     PairCache pairs{scene, cam, {}};
     double minSeparatedGap = kInf;  // smallest d2 - d1 over separated fighting pixels (for the text)
-    for (size_t k = 0; k < lists.n; ++k) {
-        const size_t p = lists.pixel[k];
-        const uint32_t mask = r.fightMask[p];
-        if (!mask) continue;
+    for (size_t j = 0, k = 0; j < r.fightPixels.size(); ++j) {
+        const size_t p = r.fightPixels[j];
+        const uint32_t mask = r.fightMasks[j];
+        while (lists.pixel[k] != p) ++k;  // both ascend, and every fighting pixel is listed
         const int x = int(p % W), y = int(p / W);
         const uint32_t t1 = lists.screen1[k], t2 = lists.screen2[k];
         const uint32_t s1 = tris.source[t1], s2 = tris.source[t2];
@@ -912,22 +915,14 @@ void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &
         std::vector<uint64_t> formatPixels;
     };
     std::vector<Component> comps;
-    // The components' labels (1-based component index; 0 = none) are kept in r.hotspotOf, all 0 on
-    // entry, and replaced by the hotspot ids at the end.
-    std::vector<uint32_t> &label = r.hotspotOf;
+    // The components' labels (1-based component index; 0 = none): the thread's, all 0 between
+    // calls (the labeled pixels are cleared at the end).
+    thread_local std::vector<uint32_t> label;
+    if (label.size() != N) label.assign(N, 0);
     std::vector<size_t> stack, members;
     std::vector<double> depths, gaps;
-    const uint8_t *cls = r.pixelClass.data();
-    for (size_t seed = 0; seed < N; ++seed) {
-        // Most pixels fight nowhere (class none = 0): eight of them skipped at a time.
-        if ((seed & 7) == 0 && seed + 8 <= N) {
-            uint64_t eight;
-            std::memcpy(&eight, cls + seed, sizeof eight);
-            if (eight == 0) {
-                seed += 7;
-                continue;
-            }
-        }
+    // Seeds in scan order: a hotspot pixel fights, and the fighting pixels ascend.
+    for (const uint32_t seed : r.fightPixels) {
         if (!isHotspotPixel(seed) || label[seed]) continue;
         comps.emplace_back();
         const uint32_t id = uint32_t(comps.size());
@@ -971,7 +966,8 @@ void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &
             h.depthGapMax = std::max(h.depthGapMax, d2 - d1);
             if (ZPixelClass(r.pixelClass[p]) == ZPixelClass::coplanar) ++h.coplanarPixels;
             ++pairCount[PairCache::key(tris.source[lists.screen1[k]], tris.source[lists.screen2[k]])];
-            for (size_t i = 0; i < F; ++i) cp.formatPixels[i] += r.fightMask[p] >> i & 1;
+            const uint32_t mask = r.fightMaskAt(p);
+            for (size_t i = 0; i < F; ++i) cp.formatPixels[i] += mask >> i & 1;
         }
         cp.area = members.size();
         h.area = cp.area;
@@ -1012,9 +1008,14 @@ void findHotspots(const Scene &scene, const Camera &cam, const ScreenTriangles &
         explainHotspot(cam.nearZ, cam.farZ, settings.viewFormat, h.coplanarPixels == h.area, &h);
         r.hotspots.push_back(std::move(h));
     }
-    for (size_t p = 0; p < N; ++p)  // every hotspot pixel has a label, and only they
-        if (isHotspotPixel(p)) label[p] = idOfComp[label[p] - 1];
-
+    // Every hotspot pixel has a label, and only they.
+    r.hotspotPixels.clear();
+    r.hotspotIds.clear();
+    for (const uint32_t p : r.fightPixels) {
+        if (!isHotspotPixel(p)) continue;
+        if (const uint32_t id = idOfComp[label[p] - 1]) r.hotspotPixels.push_back(p), r.hotspotIds.push_back(id);
+        label[p] = 0;
+    }
 }
 
 // 5. Recommendation: fewest bits with no non-coplanar fighting pixel; ties in settings order.
@@ -1058,8 +1059,6 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     r.farZ = cam.farZ;
     r.formats = settings.formats;
     r.pixelClass.assign(N, uint8_t(ZPixelClass::none));
-    r.fightMask.assign(N, 0);
-    r.hotspotOf.assign(N, 0);
     r.perFormat.resize(F);
     for (size_t i = 0; i < F; ++i) {
         const DepthFormatInfo &info = depthFormatInfo(settings.formats[i].format);

@@ -22,6 +22,7 @@
 //     writeZFightImage(z, view.buffer, dir + "/NAME.zfight.png", &err);   // reports/zfight_image.h
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -229,16 +230,31 @@ struct ZFightResult {
     std::optional<DepthFormatSpec> recommended;
     std::string recommendation;
 
-    // Per-pixel layers for the image (row-major, width x height).
+    // Per-pixel layers for the image (pixel = y * width + x): the class of every pixel; the few
+    // pixels that fight somewhere (about 1% of a view or fewer) and those of hotspots as lists,
+    // ascending in pixel (a whole-view array of each cost more to clear than the analysis).
     std::vector<uint8_t> pixelClass;     // ZPixelClass
-    std::vector<uint32_t> fightMask;     // bit i: fights in formats[i]
-    std::vector<uint32_t> hotspotOf;     // hotspot id (1-based, also beyond the listed ones); 0 = none
+    std::vector<uint32_t> fightPixels;   // the pixels fighting in some format
+    std::vector<uint32_t> fightMasks;    // per fightPixels entry: bit i = fights in formats[i] (nonzero)
+    std::vector<uint32_t> hotspotPixels; // the pixels of hotspots (every component, listed or not)
+    std::vector<uint32_t> hotspotIds;    // per hotspotPixels entry: its hotspot id (1-based)
     double ms = 0;                       // wall time of the analysis (the pipeline's clock)
+    // Pixel p's fight mask (0: fights nowhere) and hotspot id (0: none).
+    uint32_t fightMaskAt(size_t p) const { return valueAt(fightPixels, fightMasks, p); }
+    uint32_t hotspotAt(size_t p) const { return valueAt(hotspotPixels, hotspotIds, p); }
     // Frees the per-pixel buffers once the images are written (the statistics and hotspots stay).
     void releasePixels() {
         std::vector<uint8_t>().swap(pixelClass);
-        std::vector<uint32_t>().swap(fightMask);
-        std::vector<uint32_t>().swap(hotspotOf);
+        std::vector<uint32_t>().swap(fightPixels);
+        std::vector<uint32_t>().swap(fightMasks);
+        std::vector<uint32_t>().swap(hotspotPixels);
+        std::vector<uint32_t>().swap(hotspotIds);
+    }
+
+private:
+    static uint32_t valueAt(const std::vector<uint32_t> &pixels, const std::vector<uint32_t> &values, size_t p) {
+        const auto it = std::lower_bound(pixels.begin(), pixels.end(), p, [](uint32_t a, size_t b) { return a < b; });
+        return it != pixels.end() && *it == p ? values[size_t(it - pixels.begin())] : 0;
     }
 };
 
