@@ -68,6 +68,14 @@ TEST(FuzzRegressions, OffHeaderOnly) {
               "cannot be checked before OpenMesh's reader trusts them); convert the mesh to ascii OFF or PLY");
 }
 
+TEST(FuzzRegressions, OffCountsLineWithMoreWords) {
+    // fuzz_off (hang): OpenMesh read "1 13 0" after the three counts as the first vertex, each
+    // later line one vertex off, and the first face's corner count from "-1" (2^32 - 1 corners).
+    EXPECT_EQ(loadError("counts.off", "OFF\n2 1 0 1  13 0\n\n1 0 -1\n-1 0 0\n1 0 0\n1 3 0\n-1 3 0\n4 0 1  13\n"),
+              "P:2: expected the OFF counts line 'VERTICES FACES EDGES' (exactly three integers; OpenMesh's "
+              "reader needs the edge count, 0 is fine), got '2 1 0 1  13 0'");
+}
+
 TEST(FuzzRegressions, OffMalformedFaceWords) {
     // fuzz_off (hangs): "2-3" and a trailing 42949672951 desynchronized OpenMesh's reader, which
     // then read a huge corner count from the wrong word.

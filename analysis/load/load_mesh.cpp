@@ -566,9 +566,11 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
         }
         if (state == kCounts) {
             const auto c = words(l);
-            if (c.size() < 3 || !parseCount(c[0], &nv) || !parseCount(c[1], &nf) || !parseCount(c[2], &ne)) {
-                msg = at + "expected the OFF counts line 'VERTICES FACES EDGES' (three integers; OpenMesh's reader "
-                           "needs the edge count, 0 is fine), got '" + clip(l) + "'";
+            // Exactly three: OpenMesh's reader takes the words after them as the first vertex, and
+            // everything after that one word off (a vertex line read as a corner count of 2^32 - 1).
+            if (c.size() != 3 || !parseCount(c[0], &nv) || !parseCount(c[1], &nf) || !parseCount(c[2], &ne)) {
+                msg = at + "expected the OFF counts line 'VERTICES FACES EDGES' (exactly three integers; OpenMesh's "
+                           "reader needs the edge count, 0 is fine), got '" + clip(l) + "'";
                 return false;
             }
             state = nv > 0 ? kVertices : nf > 0 ? kFaces : kDone;
