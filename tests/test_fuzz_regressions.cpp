@@ -54,8 +54,8 @@ TEST(FuzzRegressions, OffNegativeCornerCount) {
               "cannot be checked before OpenMesh's reader trusts them); convert the mesh to ascii OFF or PLY");
     // The same face in plain text.
     EXPECT_EQ(loadError("valence2.off", "OFF\n3 1 0\n-1 0 0\n1 0 0\n1 3 0\n-1 2 0\n"),
-              "P:6: face 0 '-1 2 0': expected the number of corners N, then N vertex indices below 3 and at "
-              "most a color on the line; fix the face (or the counts line)");
+              "P:6: face 0 '-1 2 0': expected the number of corners N, then N vertex indices below 3 "
+              "and nothing else on the line (a face color needs a C header: COFF); fix the face (or the counts line)");
 }
 
 TEST(FuzzRegressions, OffHeaderOnly) {
@@ -81,12 +81,25 @@ TEST(FuzzRegressions, OffMalformedFaceWords) {
     // then read a huge corner count from the wrong word.
     EXPECT_EQ(loadError("word.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 0\n0 1 0\n3 0 2 1\n3 0 1 3\n2 1 2-3\n"
                                     "3 2 0 3\n4 0 3 4 2\n"),
-              "P:10: face 2 '2 1 2-3': expected the number of corners N, then N vertex indices below 5 and at "
-              "most a color on the line; fix the face (or the counts line)");
+              "P:10: face 2 '2 1 2-3': expected the number of corners N, then N vertex indices below 5 "
+              "and nothing else on the line (a face color needs a C header: COFF); fix the face (or the counts line)");
     EXPECT_EQ(loadError("word2.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n3 0 2 0 42949672951\n"
                                      "1 1 0 0\n1 0 0\n1 3 00 1\n1 1 0\n0 1  0 ! 4 2\n"),
               "P:8: face 0 '3 0 2 0 42949672951': expected the number of corners N, then N vertex indices "
-              "below 5 and at most a color on the line; fix the face (or the counts line)");
+              "below 5 and nothing else on the line (a face color needs a C header: COFF); fix the face (or the counts line)");
+    // fuzz_off (hang): in a file without C in its header OpenMesh leaves a face's further words
+    // ("1 0 10": the 10) for the next face to read as its corner count.
+    EXPECT_EQ(loadError("word3.off", "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n3 1 2 0\n1 0 10\n0 1 0\n0 00\n"
+                                     "3 0 2 1\n3 042949672954 2\n"),
+              "P:9: face 1 '1 0 10': expected the number of corners N, then N vertex indices below 5 "
+              "and nothing else on the line (a face color needs a C header: COFF); fix the face (or the counts line)");
+    // With C in the header the reader takes the rest of a face's line as its color.
+    EXPECT_EQ(loadError("color.off", "COFF\n3 1 0\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2 9 9 9 9 9\n"),
+              "P:6: face 0 '3 0 1 2 9 9 9 9 9': expected the number of corners N, then N vertex indices below 3 "
+              "and at most a color on the line; fix the face (or the counts line)");
+    // With N every vertex line holds its normal: OpenMesh would read it from the next line.
+    EXPECT_EQ(loadError("normals.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0\n0 1 0 0 0 1\n3 0 1 2\n"),
+              "P:4: vertex 1 '1 0 0': expected 3 coordinates and 3 normal components on the line");
 }
 
 TEST(FuzzRegressions, PlyHeaderOpenMeshCannotParse) {

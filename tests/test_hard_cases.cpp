@@ -669,7 +669,7 @@ TEST_F(HardInput, OutOfRangeIndexIsAnErrorNamingTheFace) {
                                     "counting from 1); fix the index or add the vertex");
     const std::string off = write("bad.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 7\n");
     EXPECT_EQ(loadError(off), off + ":7: face 1 '3 0 1 7': expected the number of corners N, then N vertex indices below 3 "
-                                    "and at most a color on the line; fix the face (or the counts line)");
+                                    "and nothing else on the line (a face color needs a C header: COFF); fix the face (or the counts line)");
     std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                       "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
                       "3 0 1 2\n3 5 1 2\n";

@@ -544,7 +544,13 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
     }
     enum { kHeader, kCounts, kVertices, kFaces, kDone } state = kHeader;
     uint64_t nv = 0, nf = 0, ne = 0, seen = 0;
-    bool plain = false;  // "OFF": exactly 3 coordinates per vertex line
+    // OpenMesh's ascii reader takes a vertex's 3 coordinates (and 3 normal components with N) word
+    // by word and then the rest of its line; a face's corner count and corners word by word, and
+    // the rest of its line (a color) only when the header asks for colors (C): anything else left
+    // on a line would be read as the next vertex or face, every later one off.
+    bool plain = false;       // "OFF": exactly 3 coordinates per vertex line
+    bool normals = false;     // [ST][C]N...OFF: a vertex line holds 3 normal components too
+    bool faceColors = false;  // [ST]C...OFF: a face line may end with a color
     std::string msg;
     forEachLine(text, [&](size_t n, std::string_view l) {
         const std::string_view w = firstWord(l);
@@ -554,6 +560,11 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
             state = kCounts;
             if (w.size() >= 3 && w.substr(w.size() - 3) == "OFF") {
                 plain = w == "OFF";
+                std::string_view prefix = w.substr(0, w.size() - 3);  // [ST][C][N][4][n], as OpenMesh reads it
+                if (prefix.substr(0, 2) == "ST") prefix.remove_prefix(2);
+                faceColors = !prefix.empty() && prefix[0] == 'C';
+                if (faceColors) prefix.remove_prefix(1);
+                normals = !prefix.empty() && prefix[0] == 'N';
                 if (l.find("BINARY") != std::string_view::npos) {
                     msg = at + "binary OFF is not supported (its counts cannot be checked before OpenMesh's "
                                "reader trusts them); convert the mesh to ascii OFF or PLY";
@@ -578,20 +589,22 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
         }
         ++seen;
         if (state == kVertices) {
-            const size_t nw = words(l).size();
-            if (plain ? nw != 3 : nw < 3) {
+            const size_t nw = words(l).size(), need = normals ? 6 : 3;
+            if (plain ? nw != 3 : nw < need) {
                 msg = at + "vertex " + std::to_string(seen - 1) + " '" + clip(l) + "': expected " +
-                      (plain ? "exactly " : "") + "3 coordinates on the line";
+                      (plain ? "exactly " : "") + (normals ? "3 coordinates and 3 normal components" : "3 coordinates") +
+                      " on the line";
                 return false;
             }
             if (seen == nv) state = nf > 0 ? kFaces : kDone, seen = 0;
             return state != kDone;
         }
         const auto f = words(l);
-        // N, N indices below the vertex count, then at most a color (up to 4 numbers 0..255): every
-        // word stays small, so no misread can become a huge corner count.
+        // N, N indices below the vertex count, then at most a color (up to 4 numbers 0..255) when the
+        // header has C, nothing else otherwise: every word stays small and the reader stays on its
+        // line, so no misread can become a huge corner count.
         uint64_t corners = 0, index = 0;
-        bool ok = parseCount(f[0], &corners) && corners + 1 <= f.size() && f.size() <= corners + 5;
+        bool ok = parseCount(f[0], &corners) && corners + 1 <= f.size() && f.size() <= corners + (faceColors ? 5 : 1);
         for (uint64_t k = 1; ok && k <= corners; ++k) ok = parseCount(f[k], &index) && index < nv;
         for (size_t k = size_t(corners) + 1; ok && k < f.size(); ++k) {
             const std::string t(f[k]);
@@ -601,7 +614,10 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
         }
         if (!ok) {
             msg = at + "face " + std::to_string(seen - 1) + " '" + clip(l) + "': expected the number of corners N, then N vertex "
-                       "indices below " + std::to_string(nv) + " and at most a color on the line; fix the face (or the counts line)";
+                       "indices below " + std::to_string(nv) +
+                  (faceColors ? " and at most a color on the line"
+                              : " and nothing else on the line (a face color needs a C header: COFF)") +
+                  "; fix the face (or the counts line)";
             return false;
         }
         if (seen == nf) state = kDone;
