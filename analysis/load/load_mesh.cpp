@@ -553,8 +553,10 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
     bool faceColors = false;  // [ST]C...OFF: a face line may end with a color
     std::string msg;
     forEachLine(text, [&](size_t n, std::string_view l) {
-        const std::string_view w = firstWord(l);
-        if (w.empty() || w[0] == '#') return true;
+        // Words as the stream extraction sees them (a line of only '\r' holds none).
+        const std::vector<std::string_view> lineWords = words(l);
+        if (lineWords.empty() || lineWords[0][0] == '#') return true;
+        const std::string_view w = lineWords[0];
         const std::string at = path + ":" + std::to_string(n) + ": ";
         if (state == kHeader) {
             state = kCounts;
@@ -576,7 +578,7 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
             return false;
         }
         if (state == kCounts) {
-            const auto c = words(l);
+            const auto &c = lineWords;
             // Exactly three: OpenMesh's reader takes the words after them as the first vertex, and
             // everything after that one word off (a vertex line read as a corner count of 2^32 - 1).
             if (c.size() != 3 || !parseCount(c[0], &nv) || !parseCount(c[1], &nf) || !parseCount(c[2], &ne)) {
@@ -589,7 +591,7 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
         }
         ++seen;
         if (state == kVertices) {
-            const size_t nw = words(l).size(), need = normals ? 6 : 3;
+            const size_t nw = lineWords.size(), need = normals ? 6 : 3;
             if (plain ? nw != 3 : nw < need) {
                 msg = at + "vertex " + std::to_string(seen - 1) + " '" + clip(l) + "': expected " +
                       (plain ? "exactly " : "") + (normals ? "3 coordinates and 3 normal components" : "3 coordinates") +
@@ -599,7 +601,7 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
             if (seen == nv) state = nf > 0 ? kFaces : kDone, seen = 0;
             return state != kDone;
         }
-        const auto f = words(l);
+        const auto &f = lineWords;
         // N, N indices below the vertex count, then at most a color (up to 4 numbers 0..255) when the
         // header has C, nothing else otherwise: every word stays small and the reader stays on its
         // line, so no misread can become a huge corner count.
