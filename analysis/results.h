@@ -156,10 +156,7 @@ struct ViewResult {
         if (raycast.ran()) raycast->releasePixels();
         if (effects.ran()) effects->releasePixels();
         if (audit.ran()) audit->releasePixels();
-        if (ordering.ran()) {
-            recycleOrderingIds(*ordering);  // for a later view's draws
-            ordering->releasePixels();
-        }
+        if (ordering.ran()) ordering->releasePixels();
         if (zfight.ran()) zfight->releasePixels();
     }
 };

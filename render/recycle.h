@@ -9,7 +9,6 @@
 // view in flight), so the peak memory does not change; taking from an empty one gives a fresh T.
 #pragma once
 
-#include <cstdint>
 #include <mutex>
 #include <utility>
 #include <vector>
@@ -42,18 +41,6 @@ template <class T>
 Recycler<T> &recyclerOf() {
     static Recycler<T> &r = *new Recycler<T>;
     return r;
-}
-
-// Whole-view id buffers (a uint32_t per pixel: the ordering audit's draws and scanline) handed on
-// with their stale contents: a taker whose buffer has the view's size writes every pixel itself
-// instead of having it cleared first. takeIdBuffer is empty when none was given back.
-struct IdBuffer {
-    std::vector<uint32_t> ids;
-};
-inline std::vector<uint32_t> takeIdBuffer() { return std::move(recyclerOf<IdBuffer>().take().ids); }
-inline void giveIdBuffer(std::vector<uint32_t> &ids) {
-    if (ids.capacity()) recyclerOf<IdBuffer>().give(IdBuffer{std::move(ids)});
-    ids = {};
 }
 
 }  // namespace va

@@ -5,7 +5,6 @@
 #include <limits>
 
 #include "render/raster_core.h"
-#include "render/recycle.h"
 #include "render/stopwatch.h"
 
 namespace va {
@@ -27,10 +26,7 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
     r.width = std::max(width, 0);
     r.height = std::max(height, 0);
     const int64_t W = r.width, H = r.height;
-    // Every row is written below (a row without spans as zeros): a recycled buffer of this size is
-    // taken as it is.
-    r.id = takeIdBuffer();
-    if (r.id.size() != size_t(W) * size_t(H)) r.id.assign(size_t(W) * size_t(H), 0);
+    r.id.assign(size_t(W) * size_t(H), 0);
     r.trianglesIn = tris.size();
     r.zbufferBytes = uint64_t(W) * uint64_t(H) * (sizeof(uint32_t) + sizeof(double));
     if (W == 0 || H == 0) return r;
@@ -121,10 +117,7 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
         }
         maxSpans = std::max(maxSpans, spans.size());
         r.spans += spans.size();
-        if (spans.empty()) {
-            std::fill(r.id.begin() + y * W, r.id.begin() + (y + 1) * W, 0u);
-            continue;
-        }
+        if (spans.empty()) continue;
 
         // How many spans hold each center (a difference array over the row).
         std::fill(cover.begin(), cover.end(), 0);

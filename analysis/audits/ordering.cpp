@@ -12,7 +12,6 @@
 
 #include "render/clip.h"
 #include "render/raster_core.h"
-#include "render/recycle.h"
 #include "render/stopwatch.h"
 
 namespace va {
@@ -477,14 +476,8 @@ struct BandedDraw {
         bandLists(runs.size(), bands, [&](size_t r) { return std::pair<size_t, size_t>{firstBand[r], runs[r].lastBand}; },
                   bandBegin, bandRuns);
         if (job.depthTest) depth.resize(bandPixels);
-        if (!job.depthTest || job.idsOut) {
-            // Each band clears its rows before drawing them (drawBand): a buffer of the right size is
-            // taken as it is, its memory neither cleared nor faulted in again.
-            if (id.empty()) id = takeIdBuffer();
-            if (id.size() != pixels) id.assign(pixels, 0);
-        } else {
-            id.clear();
-        }
+        id.clear();
+        if (!job.depthTest || job.idsOut) id.resize(pixels, 0);
     }
 
     template <bool kDepthTest>
@@ -494,7 +487,6 @@ struct BandedDraw {
         uint32_t *ids = id.data();
         double *z = depth.data();  // the band's: pixel - p0
         if constexpr (kDepthTest) std::fill(depth.begin(), depth.end(), std::numeric_limits<double>::infinity());
-        if (!kDepthTest || keepIds) std::fill(ids + p0, ids + p1, 0u);
         uint64_t n = 0, pass = 0, cover = 0;
         auto write = [&](uint32_t pixel, double d, uint32_t current) {
             if constexpr (!kDepthTest) {
@@ -938,12 +930,6 @@ ABufferResult abufferForView(const OrderingView &v, uint32_t maxListLength) {
     return resolveABuffer(v.all, v.cam.width, v.cam.height, v.cam.orthographic, m, maxListLength);
 }
 
-void recycleOrderingIds(OrderingResult &r) {
-    giveIdBuffer(r.painter.id);
-    giveIdBuffer(r.bsp.id);
-    giveIdBuffer(r.scanline.id);
-}
-
 OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const ReferenceVisibility &ref,
                                const BspTree &tree, const EffectDecision &abuffer, const OrderingSettings &settings) {
     const Stopwatch t0;
@@ -1045,7 +1031,6 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         zrow.edgePixels = c.edgePixels;
         zrow.overdraw = covered ? double(sub.depthPasses) / double(covered) : 0;
         zrow.memoryBytes = pixels * (sizeof(uint32_t) + sizeof(double));  // ids and depths
-        giveIdBuffer(submittedIds);
     } else {
         ZBufferSettings zs;
         zs.encoder = makeDepthEncoder(DepthFormat::f32, cam.nearZ, cam.farZ);

@@ -218,8 +218,7 @@ struct OrderingResult {
     std::string abufferReason;                   // the planner's reason (run or skipped)
     ABufferResult abuffer;
     double ms = 0;
-    // Frees the per-pixel buffers once the images are written (the statistics stay); see also
-    // recycleOrderingIds.
+    // Frees the per-pixel buffers once the images are written (the statistics stay).
     void releasePixels() {
         std::vector<uint32_t>().swap(painter.id);
         std::vector<uint8_t>().swap(painter.cls);
@@ -239,9 +238,5 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
 // The A-buffer's per-source-triangle inputs from the scene: material alpha, a color per source
 // object (a fixed hash of its index), single-sided flags.
 ABufferResult abufferForView(const OrderingView &v, uint32_t maxListLength = kABufferDefaultMaxList);
-
-// Gives r's painter, BSP and scanline id buffers (once its images are written) to a later view's
-// draws and scanline, which take them instead of a fresh whole-view buffer each (render/recycle.h).
-void recycleOrderingIds(OrderingResult &r);
 
 }  // namespace va
