@@ -44,7 +44,8 @@ bool renderZFightImage(const ZFightResult &zf, const ZBuffer &zb, ZFightImage *o
     const int W = zf.width, H = zf.height;
     const size_t n = size_t(std::max(W, 0)) * size_t(std::max(H, 0));
     if (W <= 0 || H <= 0 || zb.width != W || zb.height != H || zb.depth.size() != n || zf.pixelClass.size() != n ||
-        zf.hotspotPixels.size() != zf.hotspotIds.size() || (!zf.hotspotPixels.empty() && zf.hotspotPixels.back() >= n)) {
+        zf.hotspotPixels.size() != zf.hotspotIds.size() ||
+        (!zf.hotspotPixels.empty() && zf.hotspotPixels.back() >= n)) {
         if (err)
             *err = "z-fighting image: the analysis (" + std::to_string(W) + "x" + std::to_string(H) +
                    ") and the z-buffer (" + std::to_string(zb.width) + "x" + std::to_string(zb.height) +

@@ -753,7 +753,9 @@ struct TwoSurfaces {
         oneMin = lo, oneMax = hi, oneUnordered = unordered;
     }
     // The listed entry of pixel p (listed: the fighting pixels are).
-    size_t entryOf(size_t p) const { return size_t(std::lower_bound(pixel.begin(), pixel.begin() + ptrdiff_t(n), uint32_t(p)) - pixel.begin()); }
+    size_t entryOf(size_t p) const {
+        return size_t(std::lower_bound(pixel.begin(), pixel.begin() + ptrdiff_t(n), uint32_t(p)) - pixel.begin());
+    }
 };
 
 // 2a's cells over the camera's depth range [near, far] (what the clip keeps; a depth outside is never
@@ -1076,8 +1078,8 @@ ZFightResult analyzeZFighting(const Scene &scene, const Camera &cam, const Scree
     const FightFilter &cells = filter.get(cam, settings.formats);
     lists.clear();
     if (!settings.reference ||
-        !twoNearestFromReference(scene, *settings.reference, tris, W, H, cam.orthographic, settings.singleSided, two, true,
-                                 [&](size_t p0, size_t p1) {
+        !twoNearestFromReference(scene, *settings.reference, tris, W, H, cam.orthographic, settings.singleSided, two,
+                                 true, [&](size_t p0, size_t p1) {
                                      lists.gather(two, p0, cells, filter.validLo, filter.validHi, p0, p1);
                                  })) {
         findTwoNearest(tris, W, H, cam.orthographic, settings.singleSided, two);

@@ -594,7 +594,8 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
             const size_t nw = lineWords.size(), need = normals ? 6 : 3;
             if (plain ? nw != 3 : nw < need) {
                 msg = at + "vertex " + std::to_string(seen - 1) + " '" + clip(l) + "': expected " +
-                      (plain ? "exactly " : "") + (normals ? "3 coordinates and 3 normal components" : "3 coordinates") +
+                      (plain ? "exactly " : "") +
+                      (normals ? "3 coordinates and 3 normal components" : "3 coordinates") +
                       " on the line";
                 return false;
             }
