@@ -97,11 +97,18 @@ TEST(FuzzRegressions, OffMalformedFaceWords) {
     EXPECT_EQ(loadError("color.off", "COFF\n3 1 0\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2 9 9 9 9 9\n"),
               "P:6: face 0 '3 0 1 2 9 9 9 9 9': expected the number of corners N, then N vertex indices below 3 "
               "and at most a color on the line; fix the face (or the counts line)");
-    // fuzz_off (UBSan: words[0] of a line without words): a line of carriage returns is blank.
-    EXPECT_EQ(loadError("cr.off", "OFF\n5 4 0\n0 0 0\n1 0 0\n0 1 0\n~ 0 1,\n10 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"
+    // fuzz_off (UBSan: words[0] of a line without words): a line of carriage returns is blank (the
+    // found input's fourth vertex, '~ 0 1,', made a number).
+    EXPECT_EQ(loadError("cr.off", "OFF\n5 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n10 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"
                                   "\r\r\r\r\r\r\n0 1\r\r\r\r\r\r\r\r#\r 0 0\r\r\r\r\r\r\r\r\r\r\r\r\r\r\n0 14 2 1 4 2\n"),
               "P:12: face 3 '0 1????????#? 0 0?????????????': expected the number of corners N, then N vertex indices below 5 "
               "and nothing else on the line (a face color needs a C header: COFF); fix the face (or the counts line)");
+    // A coordinate the stream extraction cannot read ("~") failed every later read: the file was
+    // refused over a garbage vertex index (1937010281) instead of at the vertex.
+    EXPECT_EQ(loadError("tilde.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n~ 1 0\n0 0 1\n3 0 1 2\n3 0 2 3\n"),
+              "P:5: vertex 2 '~ 1 0': '~' is not a finite decimal number; write finite coordinates");
+    EXPECT_EQ(loadError("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"),
+              "P:4: vertex 1 '1 0 nan': 'nan' is not a finite decimal number; write finite coordinates");
     // With N every vertex line holds its normal: OpenMesh would read it from the next line.
     EXPECT_EQ(loadError("normals.off", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0\n0 1 0 0 0 1\n3 0 1 2\n"),
               "P:4: vertex 1 '1 0 0': expected 3 coordinates and 3 normal components on the line");

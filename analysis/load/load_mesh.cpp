@@ -599,6 +599,19 @@ bool preCheckOff(const std::string &path, const std::string &text, std::string *
                       " on the line";
                 return false;
             }
+            // Decimal numbers the stream extraction reads whole ("~", "0x1", "nan" stop it, and every
+            // read after fails: the file would load as garbage indices).
+            for (size_t k = 0; k < need; ++k) {
+                const std::string t(lineWords[k]);
+                char *end = nullptr;
+                const double x = std::strtod(t.c_str(), &end);
+                if (t.find_first_not_of("0123456789+-.eE") != std::string::npos || end != t.c_str() + t.size() ||
+                    !std::isfinite(x)) {
+                    msg = at + "vertex " + std::to_string(seen - 1) + " '" + clip(l) + "': '" + clip(t) +
+                          "' is not a finite decimal number; write finite coordinates";
+                    return false;
+                }
+            }
             if (seen == nv) state = nf > 0 ? kFaces : kDone, seen = 0;
             return state != kDone;
         }
