@@ -26,12 +26,13 @@ struct VertexPassParams {
 };
 
 // A batch's vertices: view-space position, outcode, projected fixed point (meaningful only where
-// the outcode has no near, far or guard-band bit: elsewhere whatever the same expressions give).
+// the outcode has no near, far or guard-band bit: elsewhere whatever the same expressions give),
+// x and y interleaved as a screen triangle's corners are (sxy[2 i], sxy[2 i + 1]).
 struct BatchVertices {
     std::vector<double> x, y, z;
     std::vector<uint32_t> code;
-    std::vector<int32_t> sx, sy;
-    void resize(size_t n) { x.resize(n), y.resize(n), z.resize(n), code.resize(n), sx.resize(n), sy.resize(n); }
+    std::vector<int32_t> sxy;
+    void resize(size_t n) { x.resize(n), y.resize(n), z.resize(n), code.resize(n), sxy.resize(2 * n); }
 };
 
 // toFixed (raster.h) as selects instead of branches: the same value for every input (NaN and
@@ -60,7 +61,7 @@ template <bool kOrtho>
     const double halfW = p.halfW, halfH = p.halfH;
     double *__restrict X = bv.x.data(), *__restrict Y = bv.y.data(), *__restrict Z = bv.z.data();
     uint32_t *__restrict C = bv.code.data();
-    int32_t *__restrict SX = bv.sx.data(), *__restrict SY = bv.sy.data();
+    int32_t *__restrict SXY = bv.sxy.data();
     for (size_t i = begin; i < end; ++i) {
         const double px = pos[i].x, py = pos[i].y, pz = pos[i].z;
         const double vx = m00 * px + m01 * py + m02 * pz + m03;
@@ -75,8 +76,8 @@ template <bool kOrtho>
              uint32_t(cy < -gy * w) << (kPlaneBottom + 4) | uint32_t(cy > gy * w) << (kPlaneTop + 4);
         C[i] = c;
         const double inv = 1.0 / w;
-        SX[i] = toFixedSelect((cx * inv + 1.0) * halfW);
-        SY[i] = toFixedSelect((1.0 - cy * inv) * halfH);
+        SXY[2 * i] = toFixedSelect((cx * inv + 1.0) * halfW);
+        SXY[2 * i + 1] = toFixedSelect((1.0 - cy * inv) * halfH);
     }
 }
 
@@ -84,5 +85,25 @@ template <bool kOrtho>
 // the same bits; call only when the CPU has AVX2. (GCC 12 does not vectorize the loop above: the
 // three-double stride of the positions.)
 void transformVerticesAvx2(const VertexPassParams &p, const Vec3 *pos, uint32_t n, BatchVertices &bv);
+
+// What the accept path needs besides the vertices: DepthPlaneMaker's constants (camera.h).
+struct AcceptParams {
+    double ax, bx, ay, by;
+    bool orthographic;
+};
+// Counts of the triangles the accept path took (ClipStats' fields of the same names).
+struct AcceptCounts {
+    uint64_t inside = 0, guardBandAccepted = 0;
+};
+
+// The clip stage's common case four triangles at a time with AVX2 (clip_avx2.cpp): from the
+// batch's k-th triangle on, while all four triangles of a group are accepted whole (not trivially
+// rejected, no corner outside near, far or the guard band, a valid depth plane), appends each
+// one's plane, corners, source and plane index to `out` as clipOne does (the same operations in
+// the same order, so the same bits) and counts it. Returns how many triangles it took: a multiple
+// of 4, stopping before the first group that is not all accepted, or with fewer than 4 left (the
+// caller runs those through clipOne, in order). Call only when the CPU has AVX2.
+uint32_t acceptGroupsAvx2(const AcceptParams &p, const BatchVertices &bv, const uint32_t *indices,
+                          const ClipBatch &batch, uint32_t k, ScreenTriangles &out, AcceptCounts &counts);
 
 }  // namespace va::clip_detail

@@ -1,6 +1,7 @@
 // Exact cases for the frustum, backface and clip stages and the pipeline that joins them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -270,8 +271,8 @@ TEST(Clip, Avx2VertexPassEqualsScalarBitForBit) {
                 ASSERT_EQ(std::memcmp(&a.y[i], &b.y[i], 8), 0) << i;
                 ASSERT_EQ(std::memcmp(&a.z[i], &b.z[i], 8), 0) << i;
                 ASSERT_EQ(a.code[i], b.code[i]) << i << " ortho " << ortho;
-                ASSERT_EQ(a.sx[i], b.sx[i]) << i;
-                ASSERT_EQ(a.sy[i], b.sy[i]) << i;
+                ASSERT_EQ(a.sxy[2 * i], b.sxy[2 * i]) << i;
+                ASSERT_EQ(a.sxy[2 * i + 1], b.sxy[2 * i + 1]) << i;
             }
         }
     }
@@ -285,10 +286,114 @@ TEST(Clip, Avx2VertexPassEqualsScalarBitForBit) {
     const Vec3 pos[3] = {{0.25, -0.5, -2}, {3, 0, -2}, {0, 0, -0.25}};
     clip_detail::transformVerticesBody<false>(p, pos, 0, 3, b);
     EXPECT_EQ(b.code[0], 0u);
-    EXPECT_EQ(b.sx[0], toFixed((0.25 / 2 + 1) * 32));
-    EXPECT_EQ(b.sy[0], toFixed((1 - -0.5 / 2) * 24));
+    EXPECT_EQ(b.sxy[0], toFixed((0.25 / 2 + 1) * 32));
+    EXPECT_EQ(b.sxy[1], toFixed((1 - -0.5 / 2) * 24));
     EXPECT_EQ(b.code[1], clip_detail::outBit(kPlaneRight));  // x/w = 1.5: outside the view, inside the band
     EXPECT_EQ(b.code[2], clip_detail::outBit(kPlaneNear));
+}
+
+// clipTriangles takes groups of four accepted triangles through the AVX2 accept path and every
+// other group through clipOne; clipViewTriangles (the kit's entry) runs each triangle through
+// clipOne. Mixed groups (inside, guard band, clipped, rejected, edge-on, degenerate, triangles
+// whose depth plane overflows) in both projections: the same screen triangles and counts, bit for bit.
+TEST(Clip, AcceptPathEqualsThePerTriangleClipperBitForBit) {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (bool ortho : {false, true}) {
+        CameraSpec spec;
+        spec.eye = {0.3, 0.2, 6};
+        spec.target = {0, 0, 0};
+        spec.width = 320, spec.height = 200, spec.nearZ = 0.5, spec.farZ = 40;
+        spec.orthographic = ortho, spec.orthoHeight = 6;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+        std::vector<Vec3> pos;
+        std::vector<uint32_t> indices;
+        for (int t = 0; t < 3000; ++t) {
+            const uint32_t base = uint32_t(pos.size());
+            const int kind = int(rng() % 10);
+            // Mostly small triangles inside the view (runs of accepted groups), some large ones
+            // (guard band, clipped), some behind the eye or beyond far.
+            const double scale = kind < 6 ? 0.2 : kind < 8 ? 30 : 4;
+            const Vec3 c = kind == 9 ? Vec3{u(rng), u(rng), 8 + 50 * std::fabs(u(rng))}
+                                     : Vec3{2 * u(rng), 2 * u(rng), u(rng)};
+            for (int k = 0; k < 3; ++k) pos.push_back(c + scale * Vec3{u(rng), u(rng), u(rng)});
+            if (rng() % 50 == 0) pos[base + 2] = pos[base] + 0.5 * (pos[base + 1] - pos[base]);  // collinear: edge-on
+            if (rng() % 80 == 0) pos[base + 1] = pos[base];                                       // two corners shared
+            if (rng() % 100 == 0) pos[base + 2] = pos[base] + Vec3{1e-300, 0, 0};                 // a sliver
+            for (int k = 0; k < 3; ++k) indices.push_back(base + uint32_t(k));
+        }
+        // Triangles in a shuffled subset, so groups are not aligned with the index array.
+        std::vector<uint32_t> tris;
+        for (uint32_t t = 0; t < indices.size() / 3; ++t)
+            if (rng() % 5) tris.push_back(t);
+        std::shuffle(tris.begin() + tris.size() / 2, tris.end(), rng);
+        const std::vector<ClipBatch> batches = {{0, uint32_t(pos.size()), tris.data(), uint32_t(tris.size())}};
+        const ClipResult a = clipTriangles(cam, {pos.data(), indices.data()}, batches, {});
+
+        std::vector<Vec3> view;
+        for (uint32_t t : tris)
+            for (int k = 0; k < 3; ++k) view.push_back(transformPoint(cam.viewFromWorld, pos[indices[3 * t + k]]));
+        const ClipResult b = clipViewTriangles(cam, view, tris, {});
+
+        EXPECT_GT(a.stats.inside, 1000u);
+        EXPECT_GT(a.stats.guardBandAccepted + a.stats.clipped + a.stats.trivialRejected + a.stats.edgeOn, 100u);
+        EXPECT_GT(a.stats.edgeOn, 0u);
+        EXPECT_EQ(a.stats.trianglesIn, b.stats.trianglesIn);
+        EXPECT_EQ(a.stats.trivialRejected, b.stats.trivialRejected);
+        EXPECT_EQ(a.stats.inside, b.stats.inside);
+        EXPECT_EQ(a.stats.guardBandAccepted, b.stats.guardBandAccepted);
+        EXPECT_EQ(a.stats.clipped, b.stats.clipped);
+        EXPECT_EQ(a.stats.clippedAway, b.stats.clippedAway);
+        EXPECT_EQ(a.stats.edgeOn, b.stats.edgeOn);
+        EXPECT_EQ(a.stats.trianglesOut, b.stats.trianglesOut);
+        EXPECT_EQ(a.out.xy, b.out.xy);
+        EXPECT_EQ(a.out.source, b.out.source);
+        EXPECT_EQ(a.out.plane, b.out.plane);
+        ASSERT_EQ(a.out.planes.size(), b.out.planes.size());
+        for (size_t i = 0; i < a.out.planes.size(); ++i) {
+            const DepthPlane &p = a.out.planes[i], &q = b.out.planes[i];
+            ASSERT_TRUE(std::memcmp(&p.a, &q.a, 8) == 0 && std::memcmp(&p.b, &q.b, 8) == 0 &&
+                        std::memcmp(&p.c, &q.c, 8) == 0 && p.valid == q.valid)
+                << "plane " << i << " ortho " << ortho;
+        }
+    }
+}
+
+// Triangles inside the view whose depth plane overflows (a and c infinite, b finite): the eye at
+// the origin looking down -z, so view space is world space exactly. Perspective: the plane
+// x = 1e-320 passes 1e-320 from the eye; orthographic: a sliver 1e-320 wide seen along its plane.
+// Each is edge-on for clipOne; placed at every position of a group of four otherwise accepted
+// triangles, the accept path must drop it too.
+TEST(Clip, AcceptPathDropsOverflowingPlanesAsEdgeOn) {
+    for (bool ortho : {false, true}) {
+        CameraSpec spec;
+        spec.eye = {0, 0, 0};
+        spec.target = {0, 0, -1};
+        spec.width = 64, spec.height = 48, spec.nearZ = 0.5, spec.farZ = 40;
+        spec.orthographic = ortho, spec.orthoHeight = 4;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
+        std::vector<Vec3> pos;
+        std::vector<uint32_t> indices, tris;
+        for (int g = 0; g < 4; ++g)
+            for (int j = 0; j < 4; ++j) {
+                const uint32_t base = uint32_t(pos.size());
+                if (j == g && !ortho) pos.insert(pos.end(), {{1e-320, 0, -5}, {1e-320, 1, -5}, {1e-320, 0, -6}});
+                else if (j == g) pos.insert(pos.end(), {{0, 0, -5}, {1e-320, 0, -4.5}, {0, 0.5, -5}});
+                else pos.insert(pos.end(), {{0.1 * j, 0, -5}, {0.1 * j + 0.3, 0, -5}, {0.1 * j, 0.3, -5}});
+                for (int k = 0; k < 3; ++k) indices.push_back(base + uint32_t(k));
+                tris.push_back(uint32_t(tris.size()));
+            }
+        const std::vector<ClipBatch> batches = {{0, uint32_t(pos.size()), tris.data(), uint32_t(tris.size())}};
+        const ClipResult a = clipTriangles(cam, {pos.data(), indices.data()}, batches, {});
+        EXPECT_EQ(a.stats.edgeOn, 4u) << "ortho " << ortho;
+        EXPECT_EQ(a.stats.inside, 12u);
+        EXPECT_EQ(a.out.size(), 12u);
+        for (const DepthPlane &p : a.out.planes) EXPECT_TRUE(std::isfinite(p.a) && std::isfinite(p.c));
+    }
 }
 
 TEST(Pipeline, ClosedMeshWithBackfaceCullingCoversEachPixelOnce) {
