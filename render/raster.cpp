@@ -268,8 +268,21 @@ ZBufferResult rasterize(const ScreenTriangles &tris, int width, int height, cons
 void finishZBufferStats(const ZBuffer &zb, ZBufferStats *stats) {
     // Histogram over the (saturating) per-pixel fragment counts; [0] counts uncovered pixels.
     // Counted into a table for every uint16 value, then cut after the largest count seen.
+    // Neighbouring pixels mostly hold the same small count, and one table's increments of one
+    // entry wait for each other through memory: counts below 64 go to four small tables in turn
+    // (independent chains), the rest to the full one.
     std::vector<uint64_t> hist(size_t(0xFFFF) + 1, 0);
-    for (uint16_t c : zb.fragments) ++hist[c];
+    uint64_t small[4][64] = {};
+    const uint16_t *f = zb.fragments.data();
+    const size_t n = zb.fragments.size(), n4 = n & ~size_t(3);
+    for (size_t i = 0; i < n4; i += 4)
+        for (size_t k = 0; k < 4; ++k) {
+            const uint16_t c = f[i + k];
+            if (c < 64) ++small[k][c];
+            else ++hist[c];
+        }
+    for (size_t i = n4; i < n; ++i) ++hist[f[i]];
+    for (size_t c = 0; c < 64; ++c) hist[c] += small[0][c] + small[1][c] + small[2][c] + small[3][c];
     uint32_t maxCount = 0xFFFF;
     while (maxCount > 0 && hist[maxCount] == 0) --maxCount;
     hist.resize(size_t(maxCount) + 1);

@@ -1039,5 +1039,34 @@ TEST(RasterOptions, FragmentsPerSource) {
     EXPECT_EQ(sum, plain.stats.fragments);
 }
 
+// The depth-complexity histogram counts small counts in four tables in turn and the rest in the
+// full one: against a plain count, with counts below and above 64, the saturated 65535, and a
+// pixel count that is not a multiple of four.
+TEST(ZBufferStats, HistogramEqualsAPlainCount) {
+    std::mt19937 rng(5);
+    for (size_t pixels : {size_t(0), size_t(1), size_t(7), size_t(4099)}) {
+        ZBuffer zb;
+        zb.width = int(pixels), zb.height = 1;
+        zb.fragments.resize(pixels);
+        for (uint16_t &c : zb.fragments) {
+            const uint32_t r = rng() % 100;
+            c = r < 60   ? uint16_t(r % 4)
+                : r < 90 ? uint16_t(60 + rng() % 10)
+                : r < 99 ? uint16_t(rng() % 3000)
+                         : uint16_t(0xFFFF);
+        }
+        std::vector<uint64_t> plain(65536, 0);
+        for (uint16_t c : zb.fragments) ++plain[c];
+        size_t top = 65535;
+        while (top > 0 && plain[top] == 0) --top;
+        plain.resize(top + 1);
+        ZBufferStats st;
+        finishZBufferStats(zb, &st);
+        EXPECT_EQ(st.histogram, plain) << pixels;
+        EXPECT_EQ(st.coveredPixels, pixels - plain[0]);
+        EXPECT_EQ(st.maxDepthComplexity, uint32_t(top));
+    }
+}
+
 }  // namespace
 }  // namespace va
