@@ -107,6 +107,7 @@ struct Stage {
     uint32_t n = 0;
 
     void flush(ScreenTriangles &out) {
+        if (n == 0) return;
         out.planes.insert(out.planes.end(), planes, planes + n);
         out.xy.insert(out.xy.end(), xy, xy + 6 * n);
         out.source.insert(out.source.end(), source, source + n);

@@ -127,9 +127,12 @@ OrderingView prepareOrderingView(const Scene &scene, const Camera &cam, const Re
 }
 
 PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
-                                     const std::vector<uint32_t> &ids) {
+                                     const std::vector<uint32_t> &ids, bool keepClasses) {
     PixelComparison c;
-    c.cls.assign(ids.size(), kOrderRight);
+    if (keepClasses) c.cls.assign(ids.size(), kOrderRight);
+    auto classify = [&](size_t p, uint8_t k) {
+        if (keepClasses) c.cls[p] = k;
+    };
     const size_t w = size_t(std::max(v.cam.width, 1));
     const size_t n = std::min(ids.size(), ref.id.size());
     const uint32_t *A = ids.data(), *B = ref.id.data();
@@ -149,14 +152,14 @@ PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisib
         const double px = double(p % w) + 0.5, py = double(p / w) + 0.5;
         if (a && b &&
             viewDepthAt(v.cam, planeOfSource(v, a - 1), px, py) == viewDepthAt(v.cam, planeOfSource(v, b - 1), px, py)) {
-            c.cls[p] = kOrderTie;
+            classify(p, kOrderTie);
             ++c.tiePixels;
             continue;
         }
         // Within the coverage uncertainty of either triangle's boundary (the float frame of the
         // edge bound at the eye: the rasterizer's snapping dominates).
         const bool edge = (a && edgeAt(a - 1, px, py).nearEdge) || (b && edgeAt(b - 1, px, py).nearEdge);
-        c.cls[p] = edge ? kOrderEdge : kOrderWrong;
+        classify(p, edge ? kOrderEdge : kOrderWrong);
         (edge ? c.edgePixels : c.wrongPixels)++;
     }
     return c;
@@ -1006,7 +1009,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     // Scanline.
     r.scanline = scanlineVisibility(v.all, cam.width, cam.height, cam.orthographic, v.singleSided.data());
     {
-        const PixelComparison c = compareWithReference(v, ref, r.scanline.id);
+        const PixelComparison c = compareWithReference(v, ref, r.scanline.id, false);
         r.scanlineWrongPixels = c.wrongPixels;
         r.scanlineTiePixels = c.tiePixels;
         r.scanlineEdgePixels = c.edgePixels;
@@ -1025,7 +1028,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         const uint64_t covered = r.painter.coveredPixels;
         const DrawStats &sub = r.overdrawByOrder[0].stats;
         zrow.drawMs = sub.ms;
-        const PixelComparison c = compareWithReference(v, ref, submittedIds);
+        const PixelComparison c = compareWithReference(v, ref, submittedIds, false);
         zrow.wrongPixels = c.wrongPixels;
         zrow.tiePixels = c.tiePixels;
         zrow.edgePixels = c.edgePixels;
@@ -1040,7 +1043,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         const Stopwatch tz;
         const ZBufferResult z = rasterize(v.all, cam.width, cam.height, zs);
         zrow.drawMs = tz.ms();
-        const PixelComparison c = compareWithReference(v, ref, z.buffer.id);
+        const PixelComparison c = compareWithReference(v, ref, z.buffer.id, false);
         zrow.wrongPixels = c.wrongPixels;
         zrow.tiePixels = c.tiePixels;
         zrow.edgePixels = c.edgePixels;

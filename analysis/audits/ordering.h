@@ -65,9 +65,10 @@ struct PixelComparison {
     uint64_t tiePixels = 0;    // a different triangle at exactly the reference's depth (either may show)
     uint64_t edgePixels = 0;   // a different triangle, the center within coverage uncertainty of an edge
     std::vector<uint8_t> cls;  // per pixel: kOrderRight / kOrderWrong / kOrderTie / kOrderEdge
+                               //   (empty when the caller asked for the counts only)
 };
 PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
-                                     const std::vector<uint32_t> &ids);
+                                     const std::vector<uint32_t> &ids, bool keepClasses = true);
 
 // ---- Painter's algorithm ------------------------------------------------------------------------
 
