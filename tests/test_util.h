@@ -2,10 +2,13 @@
 #pragma once
 
 #include <array>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "analysis/scene.h"
+#include "render/camera.h"
+#include "render/raster.h"
 
 namespace va::testing_util {
 
@@ -61,6 +64,33 @@ inline Scene looseTriangles(const std::vector<std::array<Vec3, 3>> &tris, bool d
         in.objects.push_back(std::move(o));
     }
     return buildScene(std::move(in));
+}
+
+// The first difference between two clip outputs, bit for bit (corners, sources, plane indices,
+// every plane's three doubles and validity); empty when they are identical.
+inline std::string screenTrianglesDifference(const ScreenTriangles &a, const ScreenTriangles &b) {
+    if (a.xy != b.xy) return "corners (xy)";
+    if (a.source != b.source) return "sources";
+    if (a.plane != b.plane) return "plane indices";
+    if (a.planes.size() != b.planes.size()) return "plane count";
+    for (size_t i = 0; i < a.planes.size(); ++i) {
+        const DepthPlane &p = a.planes[i], &q = b.planes[i];
+        if (std::memcmp(&p.a, &q.a, 8) != 0 || std::memcmp(&p.b, &q.b, 8) != 0 || std::memcmp(&p.c, &q.c, 8) != 0 ||
+            p.valid != q.valid)
+            return "plane " + std::to_string(i);
+    }
+    return "";
+}
+
+// A camera from its eye, target, size and projection (perspective: 60 degrees; orthographic: 6
+// units high), near 0.5 and far 40; false when makeCamera refuses it.
+inline bool smallCamera(Vec3 eye, Vec3 target, int w, int h, bool orthographic, Camera *cam, std::string *err) {
+    CameraSpec spec;
+    spec.eye = eye;
+    spec.target = target;
+    spec.width = w, spec.height = h, spec.nearZ = 0.5, spec.farZ = 40;
+    spec.orthographic = orthographic, spec.orthoHeight = 6;
+    return makeCamera(spec, cam, err);
 }
 
 }  // namespace va::testing_util
