@@ -2,6 +2,8 @@
 // (clip_avx2.cpp): a batch's vertices to view space, their outcodes and their projected
 // fixed-point positions, as structure-of-arrays, without branches. Every operation is the scalar
 // one in the scalar order (-ffp-contract=off: no fused multiply-add), so both give the same bits.
+// Also the AVX2 build's accept path for the triangles (acceptGroupsAvx2, below), which reads the
+// pass's output.
 #pragma once
 
 #include <cstdint>
