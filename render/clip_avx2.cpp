@@ -96,7 +96,6 @@ void transform4(const VertexPassParams &p, const Vec3 *pos, uint32_t n, BatchVer
     transformVerticesBody<kOrtho>(p, pos, n4, n, bv);  // the last n % 4
 }
 
-
 // The staged output of up to kStage accepted triangles, appended to the ScreenTriangles at once
 // (a vector's size cannot grow without writing its new elements: one insert per array per stage).
 constexpr uint32_t kStage = 64;
