@@ -17,21 +17,11 @@ namespace {
 // linear interpolation between two vertices is exactly interpolation of the view-space segment,
 // and every clip plane below is a linear function of (x, y, w, d).
 
-// Outcode bits: the view frustum's planes, then the guard band's side planes.
-enum : uint32_t {
-    kOutNear = 1u << kPlaneNear,
-    kOutFar = 1u << kPlaneFar,
-    kOutLeft = 1u << kPlaneLeft,
-    kOutRight = 1u << kPlaneRight,
-    kOutBottom = 1u << kPlaneBottom,
-    kOutTop = 1u << kPlaneTop,
-    kOutGuardShift = 6,  // guard-band left/right/bottom/top = the side bits shifted by 4
-    kFrustumBits = 0x3F,
-    kSideBits = kOutLeft | kOutRight | kOutBottom | kOutTop,
-};
-constexpr uint32_t guardBit(int plane) { return 1u << (plane + 4); }  // planes 2..5 -> bits 6..9
-constexpr uint32_t kGuardBits = guardBit(kPlaneLeft) | guardBit(kPlaneRight) | guardBit(kPlaneBottom) |
-                                guardBit(kPlaneTop);
+// Outcode bits (clip_vertices.h): the view frustum's planes, then the guard band's side planes.
+using clip_detail::guardBit, clip_detail::kClipBits, clip_detail::kFrustumBits;
+constexpr uint32_t kOutNear = clip_detail::outBit(kPlaneNear), kOutFar = clip_detail::outBit(kPlaneFar),
+                   kOutLeft = clip_detail::outBit(kPlaneLeft), kOutRight = clip_detail::outBit(kPlaneRight),
+                   kOutBottom = clip_detail::outBit(kPlaneBottom), kOutTop = clip_detail::outBit(kPlaneTop);
 
 struct ClipSpace {
     double nearZ, farZ, gx, gy;  // gx, gy: guard-band extents in NDC units (>= 1)
@@ -129,7 +119,7 @@ int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, Cli
         return;
     }
     const uint32_t any = c0 | c1 | c2;
-    if ((any & (kOutNear | kOutFar | kGuardBits)) == 0) {
+    if ((any & kClipBits) == 0) {
         // Inside, or crossing a viewport side while staying in the guard band: the
         // rasterizer's bounding box and edge functions do the 2D clipping.
         if (any == 0)
@@ -234,7 +224,6 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
     vp.halfW = cs.halfW, vp.halfH = cs.halfH, vp.orthographic = cam.orthographic;
     const bool avx2 = __builtin_cpu_supports("avx2");
     clip_detail::BatchVertices bv;
-    const clip_detail::AcceptParams ap{planeOf.ax, planeOf.bx, planeOf.ay, planeOf.by, planeOf.orthographic};
     clip_detail::AcceptCounts accepted;
 
     for (const ClipBatch &b : batches) {
@@ -252,7 +241,7 @@ ClipResult clipTriangles(const Camera &cam, const MeshView &mesh, const std::vec
             // The common case four at a time (clip_vertices.h); the group it stops at, or the last
             // few, through clipOne.
             if (avx2) {
-                const uint32_t taken = clip_detail::acceptGroupsAvx2(ap, bv, idx, b, k, out, accepted);
+                const uint32_t taken = clip_detail::acceptGroupsAvx2(planeOf, bv, idx, b, k, out, accepted);
                 k += taken;
                 st.trianglesOut += taken;
             }
@@ -294,7 +283,7 @@ ClipResult clipViewTriangles(const Camera &cam, const std::vector<Vec3> &view, c
         for (int k = 0; k < 3; ++k) {
             cv[k] = clipVertexOf(cam, v[k]);
             code[k] = cs.outcode(cv[k]);
-            if ((code[k] & (kOutNear | kOutFar | kGuardBits)) == 0) cs.project(cv[k], &screen[2 * k]);
+            if ((code[k] & kClipBits) == 0) cs.project(cv[k], &screen[2 * k]);
         }
         clipOne(planeOf, cs, source[t], v[0], v[1], v[2], &cv[0], &cv[1], &cv[2], code[0], code[1], code[2], &screen[0],
                 &screen[2], &screen[4], r.stats, r.out, polygons);

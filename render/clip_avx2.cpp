@@ -122,13 +122,10 @@ inline __m256d isFinite4(__m256d v) {
 
 }  // namespace
 
-uint32_t acceptGroupsAvx2(const AcceptParams &p, const BatchVertices &bv, const uint32_t *indices,
+uint32_t acceptGroupsAvx2(const DepthPlaneMaker &p, const BatchVertices &bv, const uint32_t *indices,
                           const ClipBatch &batch, uint32_t k, ScreenTriangles &out, AcceptCounts &counts) {
-    // Outcode bits (clip.cpp): a group is taken when no triangle has all three corners outside one
-    // frustum plane and no corner is outside near, far or the guard band.
-    constexpr uint32_t kFrustumBits = 0x3F;
-    constexpr uint32_t kRejectBits = outBit(kPlaneNear) | outBit(kPlaneFar) | guardBit(kPlaneLeft) |
-                                     guardBit(kPlaneRight) | guardBit(kPlaneBottom) | guardBit(kPlaneTop);
+    // A group is taken when no triangle has all three corners outside one frustum plane and no
+    // corner is outside near, far or the guard band.
     const __m256d ax = _mm256_set1_pd(p.ax), bx = _mm256_set1_pd(p.bx), ay = _mm256_set1_pd(p.ay),
                   by = _mm256_set1_pd(p.by);
     const __m256d negZero = _mm256_set1_pd(-0.0), zero = _mm256_setzero_pd();
@@ -153,7 +150,7 @@ uint32_t acceptGroupsAvx2(const AcceptParams &p, const BatchVertices &bv, const 
             i0[j] = t[0] - vb, i1[j] = t[1] - vb, i2[j] = t[2] - vb;
             const uint32_t c0 = code[i0[j]], c1 = code[i1[j]], c2 = code[i2[j]];
             const uint32_t any = c0 | c1 | c2;
-            bad |= (c0 & c1 & c2 & kFrustumBits) | (any & kRejectBits);
+            bad |= (c0 & c1 & c2 & kFrustumBits) | (any & kClipBits);
             insideHere += any == 0;
         }
         if (bad) break;
@@ -234,7 +231,7 @@ void transformVerticesAvx2(const VertexPassParams &p, const Vec3 *pos, uint32_t 
     if (p.orthographic) transformVerticesBody<true>(p, pos, 0, n, bv);
     else transformVerticesBody<false>(p, pos, 0, n, bv);
 }
-uint32_t acceptGroupsAvx2(const AcceptParams &, const BatchVertices &, const uint32_t *, const ClipBatch &, uint32_t,
+uint32_t acceptGroupsAvx2(const DepthPlaneMaker &, const BatchVertices &, const uint32_t *, const ClipBatch &, uint32_t,
                           ScreenTriangles &, AcceptCounts &) {
     return 0;  // every triangle through clipOne
 }

@@ -17,6 +17,12 @@ namespace va::clip_detail {
 // planes (bit = side plane + 4).
 constexpr uint32_t outBit(int plane) { return 1u << plane; }
 constexpr uint32_t guardBit(int plane) { return 1u << (plane + 4); }  // planes 2..5 -> bits 6..9
+constexpr uint32_t kFrustumBits = 0x3F;  // all three corners sharing one: trivially rejected
+constexpr uint32_t kGuardBits = guardBit(kPlaneLeft) | guardBit(kPlaneRight) | guardBit(kPlaneBottom) |
+                                guardBit(kPlaneTop);
+// A corner with any of these sends its triangle to Sutherland-Hodgman; without them, the triangle
+// is accepted whole (inside, or crossing a viewport side within the guard band).
+constexpr uint32_t kClipBits = outBit(kPlaneNear) | outBit(kPlaneFar) | kGuardBits;
 
 // What the pass needs of the camera and the clip space: the view matrix's top three rows, the
 // clip-space scales, the near/far depths, the guard band's extents in NDC units, and the
@@ -88,11 +94,6 @@ template <bool kOrtho>
 // three-double stride of the positions.)
 void transformVerticesAvx2(const VertexPassParams &p, const Vec3 *pos, uint32_t n, BatchVertices &bv);
 
-// What the accept path needs besides the vertices: DepthPlaneMaker's constants (camera.h).
-struct AcceptParams {
-    double ax, bx, ay, by;
-    bool orthographic;
-};
 // Counts of the triangles the accept path took (ClipStats' fields of the same names).
 struct AcceptCounts {
     uint64_t inside = 0, guardBandAccepted = 0;
@@ -105,7 +106,7 @@ struct AcceptCounts {
 // the same order, so the same bits) and counts it. Returns how many triangles it took: a multiple
 // of 4, stopping before the first group that is not all accepted, or with fewer than 4 left (the
 // caller runs those through clipOne, in order). Call only when the CPU has AVX2.
-uint32_t acceptGroupsAvx2(const AcceptParams &p, const BatchVertices &bv, const uint32_t *indices,
+uint32_t acceptGroupsAvx2(const DepthPlaneMaker &p, const BatchVertices &bv, const uint32_t *indices,
                           const ClipBatch &batch, uint32_t k, ScreenTriangles &out, AcceptCounts &counts);
 
 }  // namespace va::clip_detail
