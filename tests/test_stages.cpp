@@ -161,8 +161,11 @@ TEST(Clip, TriangleCrossingNearPlaneIsClippedToAQuad) {
     EXPECT_EQ(r.clip.trianglesOut, 2u);
     EXPECT_GT(r.zbuffer.coveredPixels, 0u);
     // Every fragment lies at or beyond near (nothing from in front of the near plane is drawn).
-    for (size_t i = 0; i < r.buffer.depth.size(); ++i)
-        if (r.buffer.id[i]) EXPECT_GE(r.buffer.depth[i], 1.0 * (1 - 1e-12));
+    for (size_t i = 0; i < r.buffer.depth.size(); ++i) {
+        if (r.buffer.id[i]) {
+            EXPECT_GE(r.buffer.depth[i], 1.0 * (1 - 1e-12));
+        }
+    }
 }
 
 TEST(Clip, VertexBehindEyeNothingDrawnFromBehind) {

@@ -58,7 +58,8 @@ inline Scene looseTriangles(const std::vector<std::array<Vec3, 3>> &tris, bool d
     in.materials = {m};
     for (size_t i = 0; i < tris.size(); ++i) {
         SceneBuildInput::Object o;
-        o.name = "t" + std::to_string(i);
+        o.name = "t";
+        o.name += std::to_string(i);  // not "t" + ...: a GCC 12 -Wrestrict false positive where inlined
         o.geometry.positions = {tris[i][0], tris[i][1], tris[i][2]};
         o.geometry.indices = {0, 1, 2};
         in.objects.push_back(std::move(o));
