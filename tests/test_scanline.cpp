@@ -2,6 +2,7 @@
 // random triangles of every size, single-sided winding, memory of one row. Suite Scanline*.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
@@ -72,6 +73,36 @@ TEST(Scanline, EqualsNearestFragment) {
         EXPECT_LT(r.memoryBytes, r.zbufferBytes);
         EXPECT_EQ(r.zbufferBytes, uint64_t(W) * H * 12);
         EXPECT_GE(r.writes, r.coveredPixels);
+    }
+}
+
+// Depths within a few ulps of one another (where the comparison of plane values needs the
+// division), equal ones (ties to the lowest id), and plane values beyond 2^1000 (tiny depths, also
+// decided by the division): the same ids as the per-fragment expectation. (Not a plane value whose
+// reciprocal is +inf: a center inside one span alone takes it without a depth evaluation, where
+// the z-buffer's LESS against +inf would not write it; the clip's far plane keeps such depths out.)
+TEST(Scanline, EqualsNearestFragmentOnNearTies) {
+    for (uint32_t seed = 1; seed <= 4; ++seed) {
+        const int W = 120, H = 90;
+        ScreenTriangles st = randomTriangles(seed, 300, W, H, false);
+        for (size_t i = 0; i < st.planes.size(); ++i) {
+            DepthPlane &p = st.planes[i];
+            // Every second plane constant at 1 minus 0..15 ulps (the values the rasterizer's
+            // expression gives exactly: 0 * px + 0 * py + c = c), whose reciprocals fall on doubles
+            // twice as far apart (neighbours share one depth), some of them sloped by a hair.
+            if (i % 2 == 0) {
+                p.a = p.b = 0;
+                p.c = 1 - double(i % 16) * 0x1p-53;
+                if (i % 6 == 0) p.a = 0x1p-60;
+            }
+            if (i % 13 == 0) p.a = p.b = 0, p.c = std::ldexp(1.0, 1001);  // above 2^1000
+        }
+        Nearest ref{st, nullptr, std::vector<uint32_t>(W * H, 0),
+                    std::vector<double>(W * H, std::numeric_limits<double>::infinity())};
+        forEachFragment(st, W, H, false, ref);
+        const ScanlineResult r = scanlineVisibility(st, W, H, false, nullptr);
+        ASSERT_EQ(r.id, ref.id) << "seed " << seed;
+        EXPECT_GT(r.depthEvaluations, 0u);
     }
 }
 
