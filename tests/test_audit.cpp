@@ -8,12 +8,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "tests/test_util.h"
 #include "analysis/audits/audit.h"
 #include "analysis/stages/backface.h"
 #include "analysis/load/demo.h"
@@ -623,6 +626,137 @@ TEST(AuditCrossCheck, ClassifyHandMade) {
     const EdgeDistance e = edgeDistance(scene, cam, o, 0, best + 0.5, 63 - best + 0.5);
     EXPECT_EQ(classifyDisagreement(scene, cam, enc, o, best, 63 - best, 1, 2),
               e.nearEdge ? Disagreement::edge : Disagreement::tie);
+}
+
+// edgeDistance as it was written before its per-triangle terms were kept (every part per pixel):
+// the reference the memo and the plain call are compared with, bit for bit.
+EdgeDistance edgeDistanceFromScratch(const ViewTriangle &v, const Camera &cam, double px, double py) {
+    constexpr double u = 0x1p-24;
+    const double gamma = kEmbreeEdgeOps * u / (1 - kEmbreeEdgeOps * u);
+    EdgeDistance out;
+    double sigma;
+    if (cam.orthographic) {
+        const double a2 = (v.P[1].x - v.P[0].x) * (v.P[2].y - v.P[0].y) - (v.P[1].y - v.P[0].y) * (v.P[2].x - v.P[0].x);
+        sigma = a2 > 0 ? -1 : (a2 < 0 ? 1 : 0);
+    } else {
+        const double det = dot(v.P[0], cross(v.P[1], v.P[2]));
+        sigma = det > 0 ? 1 : (det < 0 ? -1 : 0);
+    }
+    if (sigma == 0 || !v.plane.valid) {
+        out.nearEdge = true;
+        out.tolerancePx = kSnapEdgeTolerancePx;
+        return out;
+    }
+    auto edgeF = [&](int i, int j, const ViewRay &r) {
+        return dot(cross(v.P[i] - r.origin, v.P[j] - r.origin), r.direction);
+    };
+    const ViewRay r = viewRayThroughPixel(cam, px, py);
+    const ViewRay rx = viewRayThroughPixel(cam, px + 1, py), ry = viewRayThroughPixel(cam, px, py + 1);
+    const double q[3] = {length(v.P[0] - r.origin), length(v.P[1] - r.origin), length(v.P[2] - r.origin)};
+    const double dl = length(r.direction);
+    double minS = INFINITY, minTol = kSnapEdgeTolerancePx;
+    bool allAbove = true, anyWithin = false;
+    auto take = [&](double s, double tol) {
+        if (s < -tol) allAbove = false;
+        if (s <= tol) anyWithin = true;
+        if (s < minS) minS = s, minTol = tol;
+    };
+    for (int k = 0; k < 3; ++k) {
+        const int i = k, j = (k + 1) % 3;
+        const double f = edgeF(i, j, r);
+        const double gx = edgeF(i, j, rx) - f, gy = edgeF(i, j, ry) - f;
+        const double g = std::hypot(gx, gy);
+        const double df = (gamma * q[i] * q[j] + std::sqrt(3.0) * u * (v.M[i] * q[j] + v.M[j] * q[i])) * dl;
+        if (g > 0) take(sigma * f / g, kSnapEdgeTolerancePx + df / g);
+        else take(sigma * f > 0 ? INFINITY : -INFINITY, kSnapEdgeTolerancePx);
+    }
+    const double pv = evalDepthPlane(v.plane, px, py);
+    const double gp = std::hypot(v.plane.a, v.plane.b);
+    const double d = cam.orthographic ? pv : 1 / pv;
+    double dErr = 0;
+    if (std::isfinite(d) && d > 0) {
+        const Vec3 n = cross(v.P[1] - v.P[0], v.P[2] - v.P[0]);
+        const double nl = length(n);
+        double maxM = 0, maxQ = 0;
+        for (int i = 0; i < 3; ++i) maxM = std::max(maxM, v.M[i]), maxQ = std::max(maxQ, q[i]);
+        const double across = std::sqrt(3.0) * u * maxM + gamma * (d * length(r.direction) + maxQ);
+        const double cosine = nl > 0 ? std::fabs(dot(n, r.direction)) / nl : 0;
+        dErr = cosine > 0 ? across / cosine + u * d : INFINITY;
+    }
+    for (int side = 0; side < 2; ++side) {
+        const double limit = side == 0 ? cam.nearZ : cam.farZ;
+        double s, tolValue;
+        if (cam.orthographic) {
+            s = side == 0 ? pv - limit : limit - pv;
+            tolValue = dErr + u * limit;
+        } else {
+            s = side == 0 ? 1 / limit - pv : pv - 1 / limit;
+            tolValue = (dErr + u * limit) / (limit * limit);
+        }
+        if (gp > 0) take(s / gp, kSnapEdgeTolerancePx + tolValue / gp);
+        else take(s >= 0 ? INFINITY : -INFINITY, kSnapEdgeTolerancePx);
+    }
+    out.signedPx = minS;
+    out.tolerancePx = minTol;
+    out.nearEdge = allAbove && anyWithin;
+    return out;
+}
+
+// The memo (per-triangle terms kept, a pixel's rays shared by the triangles asked there) and the
+// plain call give edgeDistanceFromScratch's values bit for bit: random triangles, some reaching
+// behind the eye, some edge-on, both projections, the memo asked in runs along rows, alternating
+// between two triangles at a pixel and switching among more than it keeps.
+TEST(AuditEdgeDistance, MemoEqualsFromScratchBitForBit) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(-4, 4);
+    std::vector<std::array<Vec3, 3>> tris;
+    for (int i = 0; i < 40; ++i) {
+        const Vec3 c{U(rng), U(rng), U(rng) - 6};
+        std::array<Vec3, 3> t;
+        for (auto &p : t) p = c + Vec3{U(rng), U(rng), U(rng) * (i % 5 == 0 ? 3 : 0.5)};
+        if (i % 7 == 0) t[2] = t[0] + (t[1] - t[0]) * 0.5;  // degenerate: no area
+        tris.push_back(t);
+    }
+    const Scene scene = testing_util::looseTriangles(tris, true);
+    for (bool ortho : {false, true}) {
+        CameraSpec cs;
+        cs.eye = {0.3, -0.2, 1};
+        cs.target = {0, 0, -6};
+        cs.orthographic = ortho;
+        cs.width = 64;
+        cs.height = 48;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+        const Vec3 origin{0.5, 0.25, -2};
+        EdgeDistanceMemo memo(scene, cam, origin);
+        uint64_t compared = 0, near = 0;
+        auto same = [&](const EdgeDistance &a, const EdgeDistance &b) {
+            return std::memcmp(&a.signedPx, &b.signedPx, sizeof(double)) == 0 &&
+                   std::memcmp(&a.tolerancePx, &b.tolerancePx, sizeof(double)) == 0 && a.nearEdge == b.nearEdge;
+        };
+        // Along rows, then down columns (the same column at the next row: only py changes).
+        std::vector<std::pair<int, int>> pixels;
+        for (int y = 0; y < cs.height; y += 3)
+            for (int x = 0; x < cs.width; ++x) pixels.push_back({x, y});
+        for (int x = 1; x < cs.width; x += 5)
+            for (int y = 0; y < cs.height; ++y) pixels.push_back({x, y});
+        for (const auto &[x, y] : pixels) {
+                const double px = x + 0.5, py = y + 0.5;
+                // Two triangles at each pixel, a third one every few pixels (the memo keeps two).
+                const uint32_t ts[3] = {uint32_t((x / 8 + y) % 40), uint32_t((x / 8 + y + 13) % 40), uint32_t(x * 7 % 40)};
+                for (int k = 0; k < (x % 5 == 0 ? 3 : 2); ++k) {
+                    const ViewTriangle v = viewTriangle(scene, cam, origin, ts[k]);
+                    const EdgeDistance expect = edgeDistanceFromScratch(v, cam, px, py);
+                    ASSERT_TRUE(same(memo(ts[k], px, py), expect)) << ortho << " " << x << " " << y << " " << ts[k];
+                    ASSERT_TRUE(same(edgeDistance(v, cam, px, py), expect));
+                    ++compared;
+                    near += expect.nearEdge;
+                }
+            }
+        EXPECT_GT(compared, 1000u);
+        EXPECT_GT(near, 0u);
+    }
 }
 
 // ---- Watertightness ----------------------------------------------------------------------------

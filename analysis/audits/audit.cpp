@@ -118,30 +118,41 @@ ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
     return v;
 }
 
-namespace {
-
 // The ray caster's depth error for triangle v at (px, py), depth d: the hit point's error across
 // the plane (vertices and ray origin rounded to float: sqrt(3) u M each; the intersection's own
 // arithmetic: gamma(kEmbreeEdgeOps) of the magnitudes, t |D| and |Q|), turned into an error along
 // the ray by 1 / |n.D| (a grazing ray moves far along itself for a small move across the plane).
-// r: the ray through (px, py); q[i] = |P[i] - r.origin| (edgeDistance has both at hand).
-double rayDepthError(const ViewTriangle &v, const ViewRay &r, const double q[3], double d) {
-    const Vec3 n = cross(v.P[1] - v.P[0], v.P[2] - v.P[0]);
-    const double nl = length(n);
-    double maxM = 0, maxQ = 0;
+// Its terms that depend on neither the ray's direction nor the depth, from q[i] = |P[i] - the ray's
+// origin| (edgeDistance has them at hand):
+struct RayDepthTerms {
+    Vec3 n;  // the triangle's (unnormalized) normal
+    double nl = 0, maxM = 0, maxQ = 0;
+};
+
+namespace {
+
+RayDepthTerms rayDepthTerms(const ViewTriangle &v, const double q[3]) {
+    RayDepthTerms t;
+    t.n = cross(v.P[1] - v.P[0], v.P[2] - v.P[0]);
+    t.nl = length(t.n);
     for (int i = 0; i < 3; ++i) {
-        maxM = std::max(maxM, v.M[i]);
-        maxQ = std::max(maxQ, q[i]);
+        t.maxM = std::max(t.maxM, v.M[i]);
+        t.maxQ = std::max(t.maxQ, q[i]);
     }
-    const double across = std::sqrt(3.0) * kFloatU * maxM + gammaF(kEmbreeEdgeOps) * (d * length(r.direction) + maxQ);
-    const double cosine = nl > 0 ? std::fabs(dot(n, r.direction)) / nl : 0;
+    return t;
+}
+// r: the ray through (px, py).
+double rayDepthError(const RayDepthTerms &t, const ViewRay &r, double d) {
+    const double across =
+        std::sqrt(3.0) * kFloatU * t.maxM + gammaF(kEmbreeEdgeOps) * (d * length(r.direction) + t.maxQ);
+    const double cosine = t.nl > 0 ? std::fabs(dot(t.n, r.direction)) / t.nl : 0;
     return cosine > 0 ? across / cosine + kFloatU * d : std::numeric_limits<double>::infinity();
 }
 
 double rayDepthError(const Camera &cam, const ViewTriangle &v, double px, double py, double d) {
     const ViewRay r = viewRayThroughPixel(cam, px, py);
     const double q[3] = {length(v.P[0] - r.origin), length(v.P[1] - r.origin), length(v.P[2] - r.origin)};
-    return rayDepthError(v, r, q, d);
+    return rayDepthError(rayDepthTerms(v, q), r, d);
 }
 
 }  // namespace
@@ -401,35 +412,75 @@ EdgeDistance edgeDistance(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
     return edgeDistance(viewTriangle(scene, cam, rayOrigin, t), cam, px, py);
 }
 
-const ViewTriangle &EdgeDistanceMemo::triangle(uint32_t t) {
-    if (id_[0] == t) return tri_[0];
-    if (id_[1] == t) return tri_[1];
-    const int slot = next_;
-    next_ ^= 1;
-    id_[slot] = t;
-    tri_[slot] = viewTriangle(scene_, cam_, rayOrigin_, t);
-    return tri_[slot];
+// The rays edgeDistance evaluates at pixel (px, py): through it and its right and lower neighbours.
+struct PixelRayTriple {
+    ViewRay r, rx, ry;
+};
+
+namespace {
+
+PixelRayTriple pixelRays(const Camera &cam, double px, double py) {
+    return {viewRayThroughPixel(cam, px, py), viewRayThroughPixel(cam, px + 1, py), viewRayThroughPixel(cam, px, py + 1)};
 }
 
-EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, double py) {
-    EdgeDistance out;
+}  // namespace
+
+// The parts of edgeDistance that depend on the triangle alone. In perspective every ray starts at
+// the eye (O = 0), so an edge's cross product (Pi - O) x (Pj - O), the distances |Pi - O|, the
+// edge's error factor and rayDepthError's terms are the same at every pixel: computed once here,
+// from the same expressions, they are the same values.
+struct EdgeTerms {
+    double sigma = 0;
+    bool perspective = false;
+    Vec3 C[3];        // perspective: edge k's (Pi - O) x (Pj - O), i = k, j = k + 1 mod 3
+    double q[3] = {}; // perspective: |Pi - O|
+    double E[3] = {}; // perspective: edge k's float error of f before the factor |D|
+    double gp = 0;    // |gradient| of the depth plane
+    RayDepthTerms depth;  // perspective
+};
+
+namespace {
+
+constexpr Vec3 kEye{0, 0, 0};  // a perspective ray's origin (viewRayThroughPixel)
+
+double edgeErrorFactor(const ViewTriangle &v, const double q[3], int i, int j) {
+    return gammaF(kEmbreeEdgeOps) * q[i] * q[j] + std::sqrt(3.0) * kFloatU * (v.M[i] * q[j] + v.M[j] * q[i]);
+}
+
+EdgeTerms edgeTerms(const ViewTriangle &v, const Camera &cam) {
+    EdgeTerms e;
     // Orientation sign so that inside is positive: perspective, the sign of det[P0, P1, P2] (the
     // edge function of edge 01 at the ray towards P2 is det); orthographic, minus the sign of the
     // 2D area (the edge function below is -cross2). Zero: the triangle is seen edge-on, covers no
     // area, and every point of it is on its boundary.
-    double sigma;
     if (cam.orthographic) {
         const double a2 = (v.P[1].x - v.P[0].x) * (v.P[2].y - v.P[0].y) - (v.P[1].y - v.P[0].y) * (v.P[2].x - v.P[0].x);
-        sigma = a2 > 0 ? -1 : (a2 < 0 ? 1 : 0);
+        e.sigma = a2 > 0 ? -1 : (a2 < 0 ? 1 : 0);
     } else {
         const double det = dot(v.P[0], cross(v.P[1], v.P[2]));
-        sigma = det > 0 ? 1 : (det < 0 ? -1 : 0);
+        e.sigma = det > 0 ? 1 : (det < 0 ? -1 : 0);
+        e.perspective = true;
+        for (int i = 0; i < 3; ++i) e.q[i] = length(v.P[i] - kEye);
+        for (int k = 0; k < 3; ++k) {
+            const int i = k, j = (k + 1) % 3;
+            e.C[k] = cross(v.P[i] - kEye, v.P[j] - kEye);
+            e.E[k] = edgeErrorFactor(v, e.q, i, j);
+        }
+        e.depth = rayDepthTerms(v, e.q);
     }
-    if (sigma == 0 || !v.plane.valid) {
+    e.gp = std::hypot(v.plane.a, v.plane.b);
+    return e;
+}
+
+EdgeDistance edgeDistance(const ViewTriangle &v, const EdgeTerms &e, const Camera &cam, const PixelRayTriple &rays,
+                          double px, double py) {
+    EdgeDistance out;
+    if (e.sigma == 0 || !v.plane.valid) {
         out.nearEdge = true;
         out.tolerancePx = kSnapEdgeTolerancePx;
         return out;
     }
+    const double sigma = e.sigma;
 
     // Edge i -> j as a function of the pixel: f(p) = ((Pi - O(p)) x (Pj - O(p))) . D(p), with the
     // ray O + t D through p (camera.h: perspective O = 0, D affine in p; orthographic O affine in
@@ -438,13 +489,18 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, d
     // behind the eye need no care), and affine in p, so its gradient is an exact difference and
     // f / |grad f| is the signed distance in pixels to the projected edge.
     // The rays through the pixel and its right and lower neighbours, and the vertices' distances
-    // from the pixel's ray origin, each computed once for the three edges.
-    auto edgeF = [&](int i, int j, const ViewRay &r) {
-        return dot(cross(v.P[i] - r.origin, v.P[j] - r.origin), r.direction);
+    // from the pixel's ray origin, each computed once for the three edges (in perspective, once
+    // per triangle: EdgeTerms).
+    const ViewRay &r = rays.r, &rx = rays.rx, &ry = rays.ry;
+    auto edgeF = [&](int k, const ViewRay &ray) {
+        if (e.perspective) return dot(e.C[k], ray.direction);
+        const int i = k, j = (k + 1) % 3;
+        return dot(cross(v.P[i] - ray.origin, v.P[j] - ray.origin), ray.direction);
     };
-    const ViewRay r = viewRayThroughPixel(cam, px, py);
-    const ViewRay rx = viewRayThroughPixel(cam, px + 1, py), ry = viewRayThroughPixel(cam, px, py + 1);
-    const double q[3] = {length(v.P[0] - r.origin), length(v.P[1] - r.origin), length(v.P[2] - r.origin)};
+    double qOrtho[3];
+    if (!e.perspective)
+        for (int i = 0; i < 3; ++i) qOrtho[i] = length(v.P[i] - r.origin);
+    const double *q = e.perspective ? e.q : qOrtho;
     const double dl = length(r.direction);
     double minS = std::numeric_limits<double>::infinity(), minTol = kSnapEdgeTolerancePx;
     bool allAbove = true;  // every constraint >= -tolerance
@@ -458,14 +514,11 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, d
         }
     };
     for (int k = 0; k < 3; ++k) {
-        const int i = k, j = (k + 1) % 3;
-        const double f = edgeF(i, j, r);
-        const double gx = edgeF(i, j, rx) - f, gy = edgeF(i, j, ry) - f;
+        const double f = edgeF(k, r);
+        const double gx = edgeF(k, rx) - f, gy = edgeF(k, ry) - f;
         const double g = std::hypot(gx, gy);
-        const double qi = q[i], qj = q[j];
         // The float ray caster's uncertainty of f (audit.h, kEmbreeEdgeOps).
-        const double df =
-            (gammaF(kEmbreeEdgeOps) * qi * qj + std::sqrt(3.0) * kFloatU * (v.M[i] * qj + v.M[j] * qi)) * dl;
+        const double df = (e.perspective ? e.E[k] : edgeErrorFactor(v, q, k, (k + 1) % 3)) * dl;
         if (g > 0) take(sigma * f / g, kSnapEdgeTolerancePx + df / g);
         else take(sigma * f > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
                   kSnapEdgeTolerancePx);
@@ -476,9 +529,10 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, d
     // The z-buffer clips exactly in double and snaps (kSnapEdgeTolerancePx); the ray caster limits
     // t to [float(near), float(far)] and computes t in float (rayDepthError).
     const double pv = evalDepthPlane(v.plane, px, py);
-    const double gp = std::hypot(v.plane.a, v.plane.b);
+    const double gp = e.gp;
     const double d = cam.orthographic ? pv : 1 / pv;
-    const double dErr = std::isfinite(d) && d > 0 ? rayDepthError(v, r, q, d) : 0;
+    const double dErr =
+        std::isfinite(d) && d > 0 ? rayDepthError(e.perspective ? e.depth : rayDepthTerms(v, q), r, d) : 0;
     for (int side = 0; side < 2; ++side) {
         const double limit = side == 0 ? cam.nearZ : cam.farZ;
         double s, tolValue;
@@ -497,6 +551,40 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, d
     out.tolerancePx = minTol;
     out.nearEdge = allAbove && anyWithin;
     return out;
+}
+
+}  // namespace
+
+EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, double py) {
+    return edgeDistance(v, edgeTerms(v, cam), cam, pixelRays(cam, px, py), px, py);
+}
+
+EdgeDistanceMemo::EdgeDistanceMemo(const Scene &scene, const Camera &cam, Vec3 rayOrigin)
+    : scene_(scene), cam_(cam), rayOrigin_(rayOrigin), terms_(std::make_unique<EdgeTerms[]>(2)),
+      rays_(std::make_unique<PixelRayTriple>()) {}
+EdgeDistanceMemo::~EdgeDistanceMemo() = default;
+
+int EdgeDistanceMemo::slot(uint32_t t) {
+    if (id_[0] == t) return 0;
+    if (id_[1] == t) return 1;
+    const int slot = next_;
+    next_ ^= 1;
+    id_[slot] = t;
+    tri_[slot] = viewTriangle(scene_, cam_, rayOrigin_, t);
+    terms_[size_t(slot)] = edgeTerms(tri_[slot], cam_);
+    return slot;
+}
+
+const ViewTriangle &EdgeDistanceMemo::triangle(uint32_t t) { return tri_[slot(t)]; }
+
+EdgeDistance EdgeDistanceMemo::operator()(uint32_t t, double px, double py) {
+    const int k = slot(t);
+    // The two triangles of a disagreeing pixel are asked at the same center: its rays once.
+    if (px != rayPx_ || py != rayPy_) {
+        *rays_ = pixelRays(cam_, px, py);
+        rayPx_ = px, rayPy_ = py;
+    }
+    return edgeDistance(tri_[k], terms_[size_t(k)], cam_, *rays_, px, py);
 }
 
 Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin,

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -308,20 +310,31 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, d
 
 // edgeDistance over the disagreeing pixels of a view, which come in runs on the same one or two
 // triangles: the view-space data of the last two triangles asked is kept (the same values).
+struct EdgeTerms;
+struct PixelRayTriple;
 class EdgeDistanceMemo {
 public:
-    EdgeDistanceMemo(const Scene &scene, const Camera &cam, Vec3 rayOrigin)
-        : scene_(scene), cam_(cam), rayOrigin_(rayOrigin) {}
-    EdgeDistance operator()(uint32_t t, double px, double py) { return edgeDistance(triangle(t), cam_, px, py); }
+    EdgeDistanceMemo(const Scene &scene, const Camera &cam, Vec3 rayOrigin);
+    ~EdgeDistanceMemo();
+    EdgeDistanceMemo(const EdgeDistanceMemo &) = delete;
+    EdgeDistanceMemo &operator=(const EdgeDistanceMemo &) = delete;
+    // edgeDistance(triangle(t), camera(), px, py), with the parts of it that depend on the
+    // triangle alone kept with the triangle, and the pixel's rays kept for the next call at the
+    // same pixel.
+    EdgeDistance operator()(uint32_t t, double px, double py);
     const ViewTriangle &triangle(uint32_t t);
     const Camera &camera() const { return cam_; }
 
 private:
+    int slot(uint32_t t);
     const Scene &scene_;
     const Camera &cam_;
     Vec3 rayOrigin_;
     uint32_t id_[2] = {UINT32_MAX, UINT32_MAX};
     ViewTriangle tri_[2];
+    std::unique_ptr<EdgeTerms[]> terms_;  // per slot
+    std::unique_ptr<PixelRayTriple> rays_;
+    double rayPx_ = std::numeric_limits<double>::quiet_NaN(), rayPy_ = std::numeric_limits<double>::quiet_NaN();
     int next_ = 0;
 };
 // classifyDisagreement through a memo (crossCheck's loop).
