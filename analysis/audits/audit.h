@@ -308,10 +308,11 @@ ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin,
 // edgeDistance from a triangle's view-space data (the same value as the call above).
 EdgeDistance edgeDistance(const ViewTriangle &v, const Camera &cam, double px, double py);
 
+struct EdgeTerms;       // audit.cpp: the parts of edgeDistance that depend on the triangle alone
+struct PixelRayTriple;  // audit.cpp: the rays through a pixel and its right and lower neighbours
+
 // edgeDistance over the disagreeing pixels of a view, which come in runs on the same one or two
 // triangles: the view-space data of the last two triangles asked is kept (the same values).
-struct EdgeTerms;
-struct PixelRayTriple;
 class EdgeDistanceMemo {
 public:
     EdgeDistanceMemo(const Scene &scene, const Camera &cam, Vec3 rayOrigin);
