@@ -215,13 +215,19 @@ std::vector<uint32_t> painterOrder(const OrderingView &v, PainterKey key) {
 namespace {
 
 // Per drawn item, its fragments in the view's fragment cache: a whole triangle's (and an unsplit
-// piece's) are its source's screen triangles' contiguous range, read in place; a split piece's are
+// piece's) are its source's screen triangles' contiguous ranges, read in place; a split piece's are
 // those of its source whose surface point the piece contains (the test the uncached sink makes per
-// fragment, on the same values), listed in `index`.
+// fragment, on the same values), as stretches of consecutive cache fragments (`range`), each
+// within one screen triangle (so its pixels ascend) and in ascending order: a piece's boundary
+// crosses a row once or twice, so a split triangle's pieces each take a stretch per row, and a
+// draw reads them in place like whole triangles (no per-fragment index to write and gather).
+struct FragmentRange {
+    uint64_t at, end;
+};
 struct ItemFragments {
-    std::vector<uint8_t> listed;  // per item: 1 when its fragments are index[begin[k], begin[k + 1])
-    std::vector<uint64_t> begin;  // per item, + 1 entry (listed items only advance it)
-    std::vector<uint32_t> index;
+    std::vector<uint8_t> listed;       // per item: 1 when its fragments are range[begin[k], begin[k + 1])
+    std::vector<uint64_t> begin;       // per item, + 1 entry (listed items only advance it)
+    std::vector<FragmentRange> range;
 };
 
 // A split source's pieces partition it by the planes of the splits that cut it, and each piece's
@@ -331,34 +337,24 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
         if (constrained(items[k]) && fragmentsOf(items[k].source).first < fragmentsOf(items[k].source).second)
             tries[items[k].source].insert(*tree, items[k].piece, uint32_t(k));  // sources with fragments only
 
-    // Per split piece its fragment count, then the lists in item order (counting sort: each
-    // source's fragments in ascending order into their owners' slots). Per cache fragment of a
-    // trie source (written before it is read; per-thread storage).
-    thread_local std::vector<uint32_t> owner;
-    if (owner.size() < fc.pixel.size()) owner.resize(fc.pixel.size());
+    // Every source's stretches of one owner, each source's in ascending order (per-thread storage),
+    // then per item its count, and its stretches in item order (a counting sort, which keeps each
+    // item's ascending).
+    struct Owned {
+        uint64_t at, end;
+        uint32_t item;
+    };
+    thread_local std::vector<Owned> owned;
+    owned.clear();
     std::vector<uint64_t> count(items.size(), 0);
-    std::unordered_map<size_t, std::vector<uint32_t>> directLists;
-    for (auto &[s, trie] : tries) {
-        if (trie.direct) continue;
-        trie.seal();
-        const auto [f0, f1] = fragmentsOf(s);
-        // Counted by runs (consecutive fragments mostly share an owner): measured faster here than
-        // a conditional increment of count[k] per fragment.
+    // Fragments [t's first, its last) of screen triangle t, with owner(f, x, y) per fragment (the
+    // pixel's column and row, stepped along a row: a division only where a row starts), as
+    // stretches of one owner (UINT32_MAX: none, not kept).
+    auto stretches = [&](uint32_t t, auto &&ownerOf) {
+        uint64_t runAt = fc.begin[t];
         uint32_t runOwner = UINT32_MAX;
-        uint64_t run = 0;
-        auto tally = [&](uint32_t k) {
-            if (k == runOwner) {
-                ++run;
-                return;
-            }
-            if (runOwner != UINT32_MAX) count[runOwner] += run;
-            runOwner = k;
-            run = 1;
-        };
-        PieceTrie::Path path;
-        // The pixel's column and row, stepped along a row (a division only where a row starts).
         size_t x = 0, y = 0, last = SIZE_MAX - 1;
-        for (uint64_t f = f0; f < f1; ++f) {
+        for (uint64_t f = fc.begin[t]; f < fc.begin[t + 1]; ++f) {
             const size_t pixel = fc.pixel[f];
             if (pixel == last + 1 && x + 1 < rays.width) {
                 ++x;
@@ -367,11 +363,20 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
                 y = pixel / rays.width;
             }
             last = pixel;
-            const uint32_t k = trie.owner(*planes, rays.point(x, y, fc.depth[f]), path);
-            owner[f] = k;
-            tally(k);
+            const uint32_t k = ownerOf(f, x, y);
+            if (k == runOwner) continue;
+            if (runOwner != UINT32_MAX) owned.push_back({runAt, f, runOwner});
+            runAt = f;
+            runOwner = k;
         }
-        if (runOwner != UINT32_MAX) count[runOwner] += run;
+        if (runOwner != UINT32_MAX) owned.push_back({runAt, fc.begin[t + 1], runOwner});
+    };
+    for (auto &[s, trie] : tries) {
+        if (trie.direct) continue;
+        trie.seal();
+        PieceTrie::Path path;
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
+            stretches(t, [&](uint64_t f, size_t x, size_t y) { return trie.owner(*planes, rays.point(x, y, fc.depth[f]), path); });
     }
     sel.listed.assign(items.size(), 0);
     for (size_t k = 0; k < items.size(); ++k) {
@@ -379,27 +384,18 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
         if (!constrained(it)) continue;
         sel.listed[k] = 1;
         const auto trie = tries.find(it.source);
-        if (trie != tries.end() && trie->second.direct) {
-            const auto [f0, f1] = fragmentsOf(it.source);
-            std::vector<uint32_t> &list = directLists[k];
-            for (uint64_t f = f0; f < f1; ++f)
-                if (bspPieceContains(*tree, *planes, it.piece, rays.point(fc.pixel[f], fc.depth[f])))
-                    list.push_back(uint32_t(f));
-            count[k] = list.size();
-        }
+        if (trie != tries.end() && trie->second.direct)
+            for (uint32_t t = v.screenBegin[it.source]; t < v.screenEnd[it.source]; ++t)
+                stretches(t, [&](uint64_t f, size_t x, size_t y) {
+                    return bspPieceContains(*tree, *planes, it.piece, rays.point(x, y, fc.depth[f])) ? uint32_t(k) : UINT32_MAX;
+                });
     }
+    for (const Owned &o : owned) ++count[o.item];
     sel.begin.assign(items.size() + 1, 0);
     for (size_t k = 0; k < items.size(); ++k) sel.begin[k + 1] = sel.begin[k] + count[k];
-    sel.index.resize(sel.begin.back());
+    sel.range.resize(sel.begin.back());
     std::vector<uint64_t> next(sel.begin.begin(), sel.begin.end() - 1);
-    for (const auto &[k, list] : directLists)
-        for (uint32_t f : list) sel.index[next[k]++] = f;
-    for (auto &[s, trie] : tries) {
-        if (trie.direct) continue;
-        const auto [f0, f1] = fragmentsOf(s);
-        for (uint64_t f = f0; f < f1; ++f)
-            if (owner[f] != UINT32_MAX) sel.index[next[owner[f]]++] = uint32_t(f);
-    }
+    for (const Owned &o : owned) sel.range[next[o.item]++] = {o.at, o.end};
 }
 
 // Draws from the fragment cache, one band of rows at a time. Within a screen triangle the cache
@@ -425,14 +421,12 @@ struct DrawJob {
     DrawStats stats;                     // out; stats.ms is this draw's own time
 };
 
-// A stretch of one item's fragments whose pixels ascend: a screen triangle's range of the cache
-// (`listed` = 0: cache indices at..end) or, for a split piece, its selected fragments of one screen
-// triangle (`listed` = 1: positions at..end of ItemFragments::index).
+// A stretch of one item's fragments whose pixels ascend: cache indices at..end, a screen
+// triangle's range or a split piece's stretch of one (ItemFragments::range).
 struct DrawRun {
     uint64_t at, end;
     uint32_t current;   // 1 + source
     uint32_t lastBand;  // the band of its last fragment
-    uint32_t listed;
 };
 
 // One draw's runs, per band the runs reaching it (in draw order), its band depth buffer and counts.
@@ -450,29 +444,22 @@ struct BandedDraw {
         runs.clear();
         firstBand.clear();
         fragments = passes = covered = 0;
-        auto addRun = [&](uint64_t at, uint64_t end, uint32_t current, uint32_t listed, uint32_t firstPixel,
-                          uint32_t lastPixel) {
-            runs.push_back({at, end, current, uint32_t(lastPixel / bandPixels), listed});
+        auto addRun = [&](uint64_t at, uint64_t end, uint32_t current, uint32_t firstPixel, uint32_t lastPixel) {
+            runs.push_back({at, end, current, uint32_t(lastPixel / bandPixels)});
             firstBand.push_back(uint32_t(firstPixel / bandPixels));
         };
         for (size_t j = 0; j < items.size(); ++j) {
             const size_t k = job.reverse ? items.size() - 1 - j : j;
             const uint32_t s = items[k].source, current = s + 1;
             if (job.sel && job.sel->listed[k]) {
-                // The item's list ascends in cache index: split it at its screen triangles' bounds.
-                const uint32_t *index = job.sel->index.data();
-                uint64_t a = job.sel->begin[k];
-                const uint64_t e = job.sel->begin[k + 1];
-                for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s] && a < e; ++t) {
-                    const uint64_t b = uint64_t(std::lower_bound(index + a, index + e, fc.begin[t + 1]) - index);
-                    if (b > a) addRun(a, b, current, 1, fc.pixel[index[a]], fc.pixel[index[b - 1]]);
-                    a = b;
+                for (uint64_t r = job.sel->begin[k]; r < job.sel->begin[k + 1]; ++r) {
+                    const FragmentRange &g = job.sel->range[r];
+                    addRun(g.at, g.end, current, fc.pixel[g.at], fc.pixel[g.end - 1]);
                 }
             } else {
                 for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
                     if (fc.begin[t + 1] > fc.begin[t])
-                        addRun(fc.begin[t], fc.begin[t + 1], current, 0, fc.pixel[fc.begin[t]],
-                               fc.pixel[fc.begin[t + 1] - 1]);
+                        addRun(fc.begin[t], fc.begin[t + 1], current, fc.pixel[fc.begin[t]], fc.pixel[fc.begin[t + 1] - 1]);
             }
         }
         bandLists(runs.size(), bands, [&](size_t r) { return std::pair<size_t, size_t>{firstBand[r], runs[r].lastBand}; },
@@ -483,7 +470,7 @@ struct BandedDraw {
     }
 
     template <bool kDepthTest>
-    void drawBand(const FragmentCache &fc, const ItemFragments *sel, bool keepIds, uint32_t b, size_t p0, uint32_t p1) {
+    void drawBand(const FragmentCache &fc, bool keepIds, uint32_t b, size_t p0, uint32_t p1) {
         const uint32_t *pixelOf = fc.pixel.data();
         const double *depthOf = fc.depth.data();
         uint32_t *ids = id.data();
@@ -505,14 +492,7 @@ struct BandedDraw {
             uint64_t f = run.at;
             const uint64_t f0 = f;
             const uint32_t current = run.current;
-            if (run.listed) {
-                const uint32_t *index = sel->index.data();
-                if (run.lastBand == b) {
-                    for (; f < run.end; ++f) write(pixelOf[index[f]], depthOf[index[f]], current);
-                } else {
-                    for (; pixelOf[index[f]] < p1; ++f) write(pixelOf[index[f]], depthOf[index[f]], current);
-                }
-            } else if (run.lastBand == b) {
+            if (run.lastBand == b) {
                 for (; f < run.end; ++f) write(pixelOf[f], depthOf[f], current);
             } else {
                 for (; pixelOf[f] < p1; ++f) write(pixelOf[f], depthOf[f], current);
@@ -561,8 +541,8 @@ void drawCached(const OrderingView &v, std::span<DrawJob> jobs) {
         for (size_t j = 0; j < jobs.size(); ++j) {
             const Stopwatch t;
             const bool keepIds = jobs[j].idsOut != nullptr;
-            if (jobs[j].depthTest) draws[j].drawBand<true>(fc, jobs[j].sel, keepIds, uint32_t(b), p0, p1);
-            else draws[j].drawBand<false>(fc, jobs[j].sel, keepIds, uint32_t(b), p0, p1);
+            if (jobs[j].depthTest) draws[j].drawBand<true>(fc, keepIds, uint32_t(b), p0, p1);
+            else draws[j].drawBand<false>(fc, keepIds, uint32_t(b), p0, p1);
             draws[j].ms += t.ms();
         }
     }
