@@ -294,6 +294,31 @@ struct PieceTrie {
             for (int i = 0; i < length; ++i) same &= ((q[i][0] * p.x + q[i][1] * p.y + q[i][2] * p.z) + q[i][3] >= 0) == side[i];
             return same;
         }
+        // Whether the four pixels of row y from column x, at view depths d[0..3], all take the
+        // path: the same expressions as holds (each point's coordinates, then each plane's value
+        // and its sign), two points to an SSE2 register.
+        bool holds4(const PixelRays &r, size_t x, size_t y, const double *d) const {
+            if (length < 0) return false;
+            const __m128d d01 = _mm_loadu_pd(d), d23 = _mm_loadu_pd(d + 2);
+            const __m128d oy = _mm_set1_pd(r.oy[y]), dy = _mm_set1_pd(r.dy[y]);
+            const __m128d oz = _mm_set1_pd(r.oz), dz = _mm_set1_pd(r.dz);
+            const __m128d x01 = _mm_add_pd(_mm_loadu_pd(&r.ox[x]), _mm_mul_pd(_mm_loadu_pd(&r.dx[x]), d01));
+            const __m128d x23 = _mm_add_pd(_mm_loadu_pd(&r.ox[x + 2]), _mm_mul_pd(_mm_loadu_pd(&r.dx[x + 2]), d23));
+            const __m128d y01 = _mm_add_pd(oy, _mm_mul_pd(dy, d01)), y23 = _mm_add_pd(oy, _mm_mul_pd(dy, d23));
+            const __m128d z01 = _mm_add_pd(oz, _mm_mul_pd(dz, d01)), z23 = _mm_add_pd(oz, _mm_mul_pd(dz, d23));
+            const __m128d zero = _mm_setzero_pd();
+            __m128d differ = zero;
+            for (int i = 0; i < length; ++i) {
+                const double *q = this->q[i];
+                const __m128d q0 = _mm_set1_pd(q[0]), q1 = _mm_set1_pd(q[1]), q2 = _mm_set1_pd(q[2]), q3 = _mm_set1_pd(q[3]);
+                const __m128d side = _mm_castsi128_pd(_mm_set1_epi64x(this->side[i] ? -1 : 0));
+                const __m128d v01 = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(q0, x01), _mm_mul_pd(q1, y01)), _mm_mul_pd(q2, z01)), q3);
+                const __m128d v23 = _mm_add_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(q0, x23), _mm_mul_pd(q1, y23)), _mm_mul_pd(q2, z23)), q3);
+                differ = _mm_or_pd(differ, _mm_xor_pd(_mm_cmpge_pd(v01, zero), side));
+                differ = _mm_or_pd(differ, _mm_xor_pd(_mm_cmpge_pd(v23, zero), side));
+            }
+            return _mm_movemask_pd(differ) == 0;
+        }
     };
     // The piece owning point p (sealed tries; UINT32_MAX: none): the last path's piece when p takes
     // that path, else a descent from the root with the sign of (q0 x + q1 y + q2 z) + q3 of each
@@ -347,14 +372,14 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
     thread_local std::vector<Owned> owned;
     owned.clear();
     std::vector<uint64_t> count(items.size(), 0);
-    // Fragments [t's first, its last) of screen triangle t, with owner(f, x, y) per fragment (the
-    // pixel's column and row, stepped along a row: a division only where a row starts), as
-    // stretches of one owner (UINT32_MAX: none, not kept).
+    // Fragments [t's first, its last) of screen triangle t as stretches of one owner (UINT32_MAX:
+    // none, not kept). ownerOf(f, x, y) gives the owner of fragment f and of how many fragments from
+    // it (the pixel's column and row, stepped along a row: a division only where a row starts).
     auto stretches = [&](uint32_t t, auto &&ownerOf) {
         uint64_t runAt = fc.begin[t];
         uint32_t runOwner = UINT32_MAX;
         size_t x = 0, y = 0, last = SIZE_MAX - 1;
-        for (uint64_t f = fc.begin[t]; f < fc.begin[t + 1]; ++f) {
+        for (uint64_t f = fc.begin[t]; f < fc.begin[t + 1];) {
             const size_t pixel = fc.pixel[f];
             if (pixel == last + 1 && x + 1 < rays.width) {
                 ++x;
@@ -362,12 +387,15 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
                 x = pixel % rays.width;
                 y = pixel / rays.width;
             }
-            last = pixel;
-            const uint32_t k = ownerOf(f, x, y);
-            if (k == runOwner) continue;
-            if (runOwner != UINT32_MAX) owned.push_back({runAt, f, runOwner});
-            runAt = f;
-            runOwner = k;
+            const auto [k, n] = ownerOf(f, x, y);
+            x += n - 1;
+            last = pixel + n - 1;
+            if (k != runOwner) {
+                if (runOwner != UINT32_MAX) owned.push_back({runAt, f, runOwner});
+                runAt = f;
+                runOwner = k;
+            }
+            f += n;
         }
         if (runOwner != UINT32_MAX) owned.push_back({runAt, fc.begin[t + 1], runOwner});
     };
@@ -375,8 +403,16 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
         if (trie.direct) continue;
         trie.seal();
         PieceTrie::Path path;
-        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t)
-            stretches(t, [&](uint64_t f, size_t x, size_t y) { return trie.owner(*planes, rays.point(x, y, fc.depth[f]), path); });
+        for (uint32_t t = v.screenBegin[s]; t < v.screenEnd[s]; ++t) {
+            const uint64_t end = fc.begin[t + 1];
+            // Four pixels of a row at once when the last path holds for all of them (nearly always).
+            stretches(t, [&](uint64_t f, size_t x, size_t y) {
+                if (f + 4 <= end && fc.pixel[f + 3] == fc.pixel[f] + 3 && x + 3 < rays.width &&
+                    path.holds4(rays, x, y, &fc.depth[f]))
+                    return std::pair<uint32_t, size_t>{path.owner, 4};
+                return std::pair<uint32_t, size_t>{trie.owner(*planes, rays.point(x, y, fc.depth[f]), path), 1};
+            });
+        }
     }
     sel.listed.assign(items.size(), 0);
     for (size_t k = 0; k < items.size(); ++k) {
@@ -387,7 +423,8 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
         if (trie != tries.end() && trie->second.direct)
             for (uint32_t t = v.screenBegin[it.source]; t < v.screenEnd[it.source]; ++t)
                 stretches(t, [&](uint64_t f, size_t x, size_t y) {
-                    return bspPieceContains(*tree, *planes, it.piece, rays.point(x, y, fc.depth[f])) ? uint32_t(k) : UINT32_MAX;
+                    const bool in = bspPieceContains(*tree, *planes, it.piece, rays.point(x, y, fc.depth[f]));
+                    return std::pair<uint32_t, size_t>{in ? uint32_t(k) : UINT32_MAX, 1};
                 });
     }
     for (const Owned &o : owned) ++count[o.item];
