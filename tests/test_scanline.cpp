@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "render/raster_core.h"
@@ -56,15 +57,16 @@ ScreenTriangles randomTriangles(uint32_t seed, int n, int W, int H, bool equalDe
 }
 
 TEST(Scanline, EqualsNearestFragment) {
-    for (uint32_t seed = 1; seed <= 6; ++seed) {
+    for (uint32_t seed = 1; seed <= 8; ++seed) {
         const int W = 200, H = 150;
+        const bool orthographic = seed > 6;  // the plane's value is the depth
         const ScreenTriangles st = randomTriangles(seed, 400, W, H, seed % 2 == 0);
         std::vector<uint8_t> single(st.size(), 0);
         for (size_t i = 0; i < single.size(); i += 2) single[i] = 1;
         Nearest ref{st, single.data(), std::vector<uint32_t>(W * H, 0),
                     std::vector<double>(W * H, std::numeric_limits<double>::infinity())};
-        forEachFragment(st, W, H, false, ref);
-        const ScanlineResult r = scanlineVisibility(st, W, H, false, single.data());
+        forEachFragment(st, W, H, orthographic, ref);
+        const ScanlineResult r = scanlineVisibility(st, W, H, orthographic, single.data());
         ASSERT_EQ(r.id, ref.id) << "seed " << seed;
         uint64_t covered = 0;
         for (uint32_t i : ref.id) covered += i != 0;
@@ -127,6 +129,44 @@ TEST(Scanline, SingleTriangleSpans) {
     // (x + 0.5 - 2) + (y + 0.5 - 1) < 16 is strict at the centers it passes through: it is not a
     // top-left edge), 16 - y centers for y = 1..15: 15 + 14 + ... + 1 = 120.
     EXPECT_EQ(r.fragments, 120u);
+}
+
+// Two copies of one right triangle (legs of 16 px, 120 centers, rows of 1 to 15 centers: the
+// four-at-a-time resolve and its tails), every center under both spans: each center's depth is
+// evaluated twice, and the second span writes it only when nearer. Exact counts, both projections.
+TEST(Scanline, OverlapCountsOfTwoCopies) {
+    struct Case {
+        double first, second;  // the two copies' depths, in drawing (span) order
+        uint64_t writes;
+        uint32_t id;           // every covered center's
+    };
+    const Case cases[] = {
+        {4, 2, 240, 2},  // the second nearer: both write
+        {2, 4, 120, 1},  // the second farther: written once
+        {4, 4, 120, 1},  // a tie: the lowest id stays
+    };
+    for (const bool orthographic : {false, true})
+        for (const Case &c : cases) {
+            ScreenTriangles st;
+            for (int k = 0; k < 2; ++k) {
+                st.xy.insert(st.xy.end(), {toFixed(2), toFixed(1), toFixed(18), toFixed(1), toFixed(2), toFixed(17)});
+                st.source.push_back(uint32_t(k));
+                st.plane.push_back(uint32_t(k));
+                DepthPlane p;
+                const double d = k == 0 ? c.first : c.second;
+                p.c = orthographic ? d : 1 / d;  // exact: 1/2 and 1/4
+                p.valid = true;
+                st.planes.push_back(p);
+            }
+            const ScanlineResult r = scanlineVisibility(st, 20, 20, orthographic, nullptr);
+            const std::string what = std::string(orthographic ? "orthographic " : "perspective ") +
+                                     std::to_string(c.first) + " then " + std::to_string(c.second);
+            EXPECT_EQ(r.fragments, 240u) << what;
+            EXPECT_EQ(r.depthEvaluations, 240u) << what;
+            EXPECT_EQ(r.writes, c.writes) << what;
+            EXPECT_EQ(r.coveredPixels, 120u) << what;
+            for (uint32_t id : r.id) ASSERT_TRUE(id == 0 || id == c.id) << what;
+        }
 }
 
 TEST(Scanline, Empty) {
