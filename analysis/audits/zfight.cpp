@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstring>
 #include <cstdio>
+#include <immintrin.h>
 #include <limits>
 #include <optional>
 #include <unordered_map>
@@ -82,6 +83,58 @@ inline void keepTwoNearest(TwoNearest &out, size_t pixel, uint32_t t, uint32_t f
     } else if (d < d2) {
         d2 = d, t2 = t;
     }
+}
+
+// keepTwoNearest for a run's fragments from f on, of screen triangle t (its source's first: `first`),
+// up to `end` or the first pixel at or past p1; pixel p at index p - base of `out`. Where four
+// fragments are four consecutive pixels (a row's inside), the four updates at once, branch-free:
+// with s1 / s2 "the first / second kept surface is this source" (s2 only without s1), lt1 = d < d1,
+// lt2 = d < d2, keepTwoNearest's cases come to
+//   slot 1 takes (d, t)            when lt1 and (s1, or neither, or s2 and lt2),
+//   slot 2 takes slot 1's old pair when that holds and not s1,
+//   slot 2 takes (d, t)            when lt2, not lt1 and not s1,
+// the same comparisons on the same values. Elsewhere keepTwoNearest itself. Returns the first
+// fragment not taken.
+// Four 64-bit lane masks as four 32-bit ones, and back. (Functions, not lambdas: a lambda does not
+// take its enclosing function's target.)
+__attribute__((target("avx2"))) inline __m128i to32(__m256d m) {
+    return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_castpd_si256(m), _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6)));
+}
+__attribute__((target("avx2"))) inline __m256d to64(__m128i m) { return _mm256_castsi256_pd(_mm256_cvtepi32_epi64(m)); }
+
+__attribute__((target("avx2"))) uint64_t keepTwoNearestRunAvx2(TwoNearest &out, size_t base, const uint32_t *pixelOf,
+                                                               const double *depthOf, uint64_t f, uint64_t end,
+                                                               size_t p1, uint32_t t, uint32_t first) {
+    const __m128i sign = _mm_set1_epi32(INT32_MIN), one = _mm_set1_epi32(1);
+    const __m128i firstB = _mm_xor_si128(_mm_set1_epi32(int32_t(first)), sign), tv = _mm_set1_epi32(int32_t(t));
+    while (f < end && pixelOf[f] < p1) {
+        const size_t p = pixelOf[f];
+        if (f + 4 <= end && pixelOf[f + 3] == p + 3 && p + 3 < p1) {
+            const size_t i = p - base;
+            double *d1p = out.depth1.data() + i, *d2p = out.depth2.data() + i;
+            __m128i *t1p = reinterpret_cast<__m128i *>(out.screen1.data() + i);
+            __m128i *t2p = reinterpret_cast<__m128i *>(out.screen2.data() + i);
+            const __m256d d = _mm256_loadu_pd(depthOf + f), d1 = _mm256_loadu_pd(d1p), d2 = _mm256_loadu_pd(d2p);
+            const __m128i t1 = _mm_loadu_si128(t1p), t2 = _mm_loadu_si128(t2p);
+            // (t + 1) > first, unsigned (kNoFragment + 1 wraps to 0): both biased by 2^31, then signed.
+            const __m128i s1 = _mm_cmpgt_epi32(_mm_xor_si128(_mm_add_epi32(t1, one), sign), firstB);
+            const __m128i s2 = _mm_andnot_si128(s1, _mm_cmpgt_epi32(_mm_xor_si128(_mm_add_epi32(t2, one), sign), firstB));
+            const __m128i neither = _mm_andnot_si128(_mm_or_si128(s1, s2), _mm_set1_epi32(-1));
+            const __m128i lt1 = to32(_mm256_cmp_pd(d, d1, _CMP_LT_OQ)), lt2 = to32(_mm256_cmp_pd(d, d2, _CMP_LT_OQ));
+            const __m128i a = _mm_and_si128(lt1, _mm_or_si128(_mm_or_si128(s1, neither), _mm_and_si128(s2, lt2)));
+            const __m128i b = _mm_andnot_si128(s1, a);
+            const __m128i c = _mm_andnot_si128(_mm_or_si128(lt1, s1), lt2);
+            _mm256_storeu_pd(d1p, _mm256_blendv_pd(d1, d, to64(a)));
+            _mm256_storeu_pd(d2p, _mm256_blendv_pd(_mm256_blendv_pd(d2, d, to64(c)), d1, to64(b)));
+            _mm_storeu_si128(t1p, _mm_blendv_epi8(t1, tv, a));
+            _mm_storeu_si128(t2p, _mm_blendv_epi8(_mm_blendv_epi8(t2, tv, c), t1, b));
+            f += 4;
+            continue;
+        }
+        keepTwoNearest(out, p - base, t, first, depthOf[f]);
+        ++f;
+    }
+    return f;
 }
 
 // The z-buffer's single-sided rule (ZBufferSettings::singleSided): a triangle of source s is drawn
@@ -241,6 +294,7 @@ bool twoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref,
         const uint32_t *px = pixelsOf(u);
         return std::pair<size_t, size_t>{px[u.at] / bandPixels, px[u.end - 1] / bandPixels};
     }, bandBegin, bandRuns);
+    const bool avx2 = __builtin_cpu_supports("avx2");
     for (size_t b = 0; b < bands; ++b) {
         const size_t p0 = b * bandPixels, p1 = std::min(p0 + bandPixels, n);
         const size_t base = bandLocal ? p0 : 0;  // r's index of pixel p: p - base
@@ -253,6 +307,7 @@ bool twoNearestFromReference(const Scene &scene, const ReferenceVisibility &ref,
             const uint32_t *pixelOf = pixelsOf(u);
             const double *depthOf = u.side ? walked.depth.data() : cache.depth.data();
             uint64_t f = u.at;
+            if (avx2) f = keepTwoNearestRunAvx2(r, base, pixelOf, depthOf, f, u.end, p1, u.tri, u.first);
             for (; f < u.end && pixelOf[f] < p1; ++f) keepTwoNearest(r, pixelOf[f] - base, u.tri, u.first, depthOf[f]);
             u.at = f;
         }
