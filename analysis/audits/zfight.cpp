@@ -85,6 +85,13 @@ inline void keepTwoNearest(TwoNearest &out, size_t pixel, uint32_t t, uint32_t f
     }
 }
 
+// Four 64-bit lane masks as four 32-bit ones, and back. (Functions, not lambdas: a lambda does not
+// take its enclosing function's target.)
+__attribute__((target("avx2"))) inline __m128i to32(__m256d m) {
+    return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_castpd_si256(m), _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6)));
+}
+__attribute__((target("avx2"))) inline __m256d to64(__m128i m) { return _mm256_castsi256_pd(_mm256_cvtepi32_epi64(m)); }
+
 // keepTwoNearest for a run's fragments from f on, of screen triangle t (its source's first: `first`),
 // up to `end` or the first pixel at or past p1; pixel p at index p - base of `out`. Where four
 // fragments are four consecutive pixels (a row's inside), the four updates at once, branch-free:
@@ -95,13 +102,6 @@ inline void keepTwoNearest(TwoNearest &out, size_t pixel, uint32_t t, uint32_t f
 //   slot 2 takes (d, t)            when lt2, not lt1 and not s1,
 // the same comparisons on the same values. Elsewhere keepTwoNearest itself. Returns the first
 // fragment not taken.
-// Four 64-bit lane masks as four 32-bit ones, and back. (Functions, not lambdas: a lambda does not
-// take its enclosing function's target.)
-__attribute__((target("avx2"))) inline __m128i to32(__m256d m) {
-    return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(_mm256_castpd_si256(m), _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6)));
-}
-__attribute__((target("avx2"))) inline __m256d to64(__m128i m) { return _mm256_castsi256_pd(_mm256_cvtepi32_epi64(m)); }
-
 __attribute__((target("avx2"))) uint64_t keepTwoNearestRunAvx2(TwoNearest &out, size_t base, const uint32_t *pixelOf,
                                                                const double *depthOf, uint64_t f, uint64_t end,
                                                                size_t p1, uint32_t t, uint32_t first) {
