@@ -270,6 +270,7 @@ TEST(ZFightTwoNearest, EqualsTheRuleInTheWalksOrder) {
     // surfaces a pixel the end state still shows each step (with five shared depths, or heavy
     // overdraw, most pixels end at two of the nearest whatever came before: a wrong step went unseen).
     for (const int count : {60, 400, 150}) {
+        const bool pieces = count == 150;  // sources of three pieces around one center
         uint64_t state = 0x9E3779B97F4A7C15ull * uint64_t(count);
         auto next = [&](int64_t lo, int64_t hi) {
             state = state * 6364136223846793005ull + 1442695040888963407ull;
@@ -279,15 +280,15 @@ TEST(ZFightTwoNearest, EqualsTheRuleInTheWalksOrder) {
         for (int k = 0; k < 5; ++k) tris.planes.push_back(DepthPlane{0, 0, double(1 + k), true});  // shared: ties
         int64_t cx = 0, cy = 0;
         for (int t = 0; t < count; ++t) {
-            const int64_t size = count == 150 ? 30 : t % 4 == 0 ? 120 : 30;
-            if (count != 150 || t % 3 == 0) cx = next(-10, W + 10), cy = next(-10, H + 10);
+            const int64_t size = pieces ? 30 : t % 4 == 0 ? 120 : 30;
+            if (!pieces || t % 3 == 0) cx = next(-10, W + 10), cy = next(-10, H + 10);
             for (int i = 0; i < 3; ++i) {
                 tris.xy.push_back(int32_t((cx + next(-size, size)) * kSubpixelOne + next(0, kSubpixelOne - 1)));
                 tris.xy.push_back(int32_t((cy + next(-size, size)) * kSubpixelOne + next(0, kSubpixelOne - 1)));
             }
-            // Every third a piece of the one before; with 150, three pieces to a source.
-            tris.source.push_back(uint32_t(count == 150 ? t / 3 * 3 : t % 3 == 1 ? t - 1 : t));
-            if (count == 150) {  // a depth of its own, so that the end state still shows every step
+            // Every third a piece of the one before; or three pieces to a source.
+            tris.source.push_back(uint32_t(pieces ? t / 3 * 3 : t % 3 == 1 ? t - 1 : t));
+            if (pieces) {  // a depth of its own, so that the end state still shows every step
                 tris.plane.push_back(uint32_t(tris.planes.size()));
                 tris.planes.push_back(DepthPlane{0, 0, 1 + double(next(0, 4000)) / 64, true});
             } else {
@@ -328,7 +329,7 @@ TEST(ZFightTwoNearest, EqualsTheRuleInTheWalksOrder) {
         EXPECT_TRUE(replayed.depth2 == rule.d2) << count;
         EXPECT_TRUE(replayed.screen1 == rule.t1) << count;
         EXPECT_TRUE(replayed.screen2 == rule.t2) << count;
-        if (count == 150)
+        if (pieces)
             EXPECT_TRUE(rule.firstsFarther > 50 && rule.secondsNearest > 50 && rule.secondsNearer > 50)
                 << rule.firstsFarther << " " << rule.secondsNearest << " " << rule.secondsNearer;
     }
