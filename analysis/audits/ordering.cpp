@@ -456,7 +456,22 @@ struct DrawJob {
     bool reverse = false;                // the items from the last to the first
     std::vector<uint32_t> *idsOut = nullptr;
     DrawStats stats;                     // out; stats.ms is this draw's own time
+    // With depthTest: the same pass is also the draw without the depth test in the same order
+    // (every fragment writes its id: the painter's draw), its ids in idsOut (the depth-tested
+    // draw's are not kept) and its counts in paintStats; both stats' ms are the one pass's.
+    bool paint = false;
+    DrawStats paintStats;                // out, with paint
 };
+DrawJob drawJob(const std::vector<DrawItem> &items, const ItemFragments *sel, bool depthTest, bool reverse,
+                std::vector<uint32_t> *idsOut) {
+    DrawJob job;
+    job.items = &items;
+    job.sel = sel;
+    job.depthTest = depthTest;
+    job.reverse = reverse;
+    job.idsOut = idsOut;
+    return job;
+}
 
 // A stretch of one item's fragments whose pixels ascend: cache indices at..end, a screen
 // triangle's range or a split piece's stretch of one (ItemFragments::range).
@@ -506,7 +521,8 @@ struct BandedDraw {
         if (!job.depthTest || job.idsOut) id.resize(pixels, 0);
     }
 
-    template <bool kDepthTest>
+    // kPaint (with kDepthTest): every fragment also writes its id, as the draw without the test.
+    template <bool kDepthTest, bool kPaint = false>
     void drawBand(const FragmentCache &fc, bool keepIds, uint32_t b, size_t p0, uint32_t p1) {
         const uint32_t *pixelOf = fc.pixel.data();
         const double *depthOf = fc.depth.data();
@@ -515,8 +531,8 @@ struct BandedDraw {
         if constexpr (kDepthTest) std::fill(depth.begin(), depth.end(), std::numeric_limits<double>::infinity());
         uint64_t n = 0, pass = 0, cover = 0;
         auto write = [&](uint32_t pixel, double d, uint32_t current) {
+            if constexpr (kPaint || !kDepthTest) ids[pixel] = current;
             if constexpr (!kDepthTest) {
-                ids[pixel] = current;
             } else if (double &old = z[pixel - p0]; d < old) {
                 cover += old == std::numeric_limits<double>::infinity();
                 old = d;
@@ -542,18 +558,30 @@ struct BandedDraw {
         covered += cover;
     }
 
-    DrawStats finish(const DrawJob &job) {
+    // The job's stats (and, with paint, job.paintStats); ms is left to the caller.
+    DrawStats finish(DrawJob &job) {
+        auto ratios = [](DrawStats &st) {
+            st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+            st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+        };
+        // Without the depth test every fragment writes, and the ids count the covered pixels.
+        auto painted = [&]() {
+            DrawStats st;
+            st.fragments = st.depthPasses = fragments;
+            for (uint32_t i : id) st.coveredPixels += i != 0;
+            ratios(st);
+            return st;
+        };
         DrawStats st;
-        st.fragments = fragments;
         if (job.depthTest) {
+            st.fragments = fragments;
             st.depthPasses = passes;
             st.coveredPixels = covered;
+            ratios(st);
+            if (job.paint) job.paintStats = painted();
         } else {
-            st.depthPasses = fragments;
-            for (uint32_t i : id) st.coveredPixels += i != 0;
+            st = painted();
         }
-        st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
-        st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
         if (job.idsOut) *job.idsOut = std::move(id);
         return st;
     }
@@ -577,9 +605,10 @@ void drawCached(const OrderingView &v, std::span<DrawJob> jobs) {
         const uint32_t p1 = uint32_t(std::min(pixels, p0 + bandPixels));
         for (size_t j = 0; j < jobs.size(); ++j) {
             const Stopwatch t;
-            const bool keepIds = jobs[j].idsOut != nullptr;
-            if (jobs[j].depthTest) draws[j].drawBand<true>(fc, keepIds, uint32_t(b), p0, p1);
-            else draws[j].drawBand<false>(fc, keepIds, uint32_t(b), p0, p1);
+            const bool keepIds = jobs[j].idsOut != nullptr && !jobs[j].paint;
+            if (!jobs[j].depthTest) draws[j].drawBand<false>(fc, keepIds, uint32_t(b), p0, p1);
+            else if (jobs[j].paint) draws[j].drawBand<true, true>(fc, false, uint32_t(b), p0, p1);
+            else draws[j].drawBand<true>(fc, keepIds, uint32_t(b), p0, p1);
             draws[j].ms += t.ms();
         }
     }
@@ -587,18 +616,14 @@ void drawCached(const OrderingView &v, std::span<DrawJob> jobs) {
         const Stopwatch t;
         jobs[j].stats = draws[j].finish(jobs[j]);
         jobs[j].stats.ms = draws[j].ms + t.ms();
+        jobs[j].paintStats.ms = jobs[j].stats.ms;
     }
 }
 
 // One draw: the items in order, or (reverse) from the last to the first.
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
                      const ItemFragments *sel, std::vector<uint32_t> *idsOut, bool reverse = false) {
-    DrawJob job;
-    job.items = &items;
-    job.sel = sel;
-    job.depthTest = depthTest;
-    job.reverse = reverse;
-    job.idsOut = idsOut;
+    DrawJob job = drawJob(items, sel, depthTest, reverse, idsOut);
     drawCached(v, std::span<DrawJob>(&job, 1));
     return job.stats;
 }
@@ -934,8 +959,8 @@ double bspSelect(const OrderingView &v, const BspTree &tree, const BspViewPlanes
     return ts.ms() + v.fragments->rasterMs;
 }
 void bspJobs(const std::vector<DrawItem> &items, const ItemFragments &sel, BspViewResult &r, DrawJob *jobs) {
-    jobs[0] = {&items, &sel, false, false, &r.id, {}};
-    jobs[1] = {&items, &sel, true, true, nullptr, {}};
+    jobs[0] = drawJob(items, &sel, false, false, &r.id);
+    jobs[1] = drawJob(items, &sel, true, true, nullptr);
 }
 void bspTakeDraws(const DrawJob *jobs, double selectMs, BspViewResult &r) {
     r.backToFront = jobs[0].stats;
@@ -1010,8 +1035,9 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
 
     // The painter's draw, the overdraw by draw order (each with the depth test; the painter's
     // order is also the back-to-front one) and the BSP's two draws. With the fragment cache the
-    // six draws run band by band together, and the submitted draw is also the z-buffer row below
-    // (kept ids).
+    // six draws run band by band together in five passes (the painter's and the back-to-front
+    // one are one pass over the same fragments), and the submitted draw is also the z-buffer row
+    // below (kept ids).
     std::vector<uint32_t> submittedIds;
     {
         std::vector<DrawItem> backToFront;
@@ -1055,16 +1081,19 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
                 const BspViewPlanes planes = bspItems(v, tree, bspItemList, r.bsp);
                 bspSelectMs = bspSelect(v, tree, planes, bspItemList, bspSel);
             }
-            DrawJob jobs[6];
-            jobs[0] = {&backToFront, nullptr, false, false, &r.painter.id, {}};  // the painter's
+            // The painter's draw is back_to_front's pass (paint): the same items in the same order.
+            DrawJob jobs[5];
             for (int k = 0; k < 3; ++k)
-                jobs[k + 1] = {orders[k], nullptr, true, false, k == 0 ? &submittedIds : nullptr, {}};
-            bspJobs(bspItemList, bspSel, r.bsp, jobs + 4);
+                jobs[k] = drawJob(*orders[k], nullptr, true, false, k == 0 ? &submittedIds : nullptr);
+            jobs[1].paint = true;
+            jobs[1].idsOut = &r.painter.id;
+            bspJobs(bspItemList, bspSel, r.bsp, jobs + 3);
             drawCached(v, jobs);
-            for (int k = 0; k < 4; ++k) jobs[k].stats.ms += v.fragments->rasterMs;
-            finishPainter(v, ref, painterSorted, settings.overlapTests, jobs[0].stats, r.painter);
-            for (int k = 0; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k + 1].stats});
-            bspTakeDraws(jobs + 4, bspSelectMs, r.bsp);
+            for (int k = 0; k < 3; ++k) jobs[k].stats.ms += v.fragments->rasterMs;
+            jobs[1].paintStats.ms += v.fragments->rasterMs;
+            finishPainter(v, ref, painterSorted, settings.overlapTests, jobs[1].paintStats, r.painter);
+            for (int k = 0; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k].stats});
+            bspTakeDraws(jobs + 3, bspSelectMs, r.bsp);
             bspCompare(v, ref, r.bsp);
         } else {
             for (int k = 0; k < 3; ++k)
