@@ -136,6 +136,11 @@ bool writeFileAtomic(const std::string &path, const std::string &contents, std::
             if (err) *err = "cannot write '" + path + "': write: " + errnoText(e);
             return false;
         }
+#if defined(__linux__)
+        // Start the file's writeback now (without waiting for it), so that the commit's syncfs
+        // finds the run's images mostly on the disk already instead of waiting for all of them.
+        ::sync_file_range(fd, 0, 0, SYNC_FILE_RANGE_WRITE);
+#endif
         if (::close(fd) != 0) {
             if (err) *err = "cannot write '" + path + "': close: " + errnoText(errno);
             return false;
