@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "reports/findings.h"
 #include "reports/ordering_images.h"
 #include "reports/report.h"
@@ -493,9 +495,14 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
                   {"views_total", r.shard.viewsTotal ? r.shard.viewsTotal : r.views.size()}};
     j["depth_curves"] = depthCurvesJson(r.depthCurves);
     const std::vector<std::string> bases = imageBaseNames(r.views);
+    // Each view's JSON depends on that view alone: built in parallel (the run's threads, once the
+    // views are analysed), then appended in order.
+    std::vector<Json> each(r.views.size());
+    tbb::parallel_for(size_t(0), r.views.size(),
+                      [&](size_t i) { each[i] = viewJson(r.views[i], bases[i], r.lightNames, images); });
     Json views = Json::array();
-    for (size_t i = 0; i < r.views.size(); ++i) views.push_back(viewJson(r.views[i], bases[i], r.lightNames, images));
-    j["views"] = views;
+    for (Json &v : each) views.push_back(std::move(v));
+    j["views"] = std::move(views);
     j["totals"] = reportTotals(j["views"]);
     addFindings(&j);
     // Routes (docs/routes.md): their definitions, then their series from the views.
