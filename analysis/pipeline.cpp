@@ -2,14 +2,17 @@
 
 #include <algorithm>
 #include <atomic>
+#include <future>
 #include <map>
 #include <mutex>
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "analysis/stage.h"
+#include "common/fp_env.h"
 #include "analysis/stages/backface.h"
 #include "analysis/stages/cells.h"
 #include "analysis/load/level_views.h"
@@ -193,7 +196,7 @@ void runCullingAudit(ViewContext &c, const TriangleLists &lists, std::vector<uin
     // The ordering audit walks the reference's fragments again in other orders: kept for it,
     // up to 4 per pixel (48 bytes a pixel; estimateMemory), above which it rasterizes again.
     const uint64_t pixels = uint64_t(std::max(c.cam.width, 0)) * uint64_t(std::max(c.cam.height, 0));
-    const uint64_t cache = c.ps.bspTree ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
+    const uint64_t cache = c.ps.hasBspTree() ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
     r.audit = CullingAuditResult{};
     CullingAuditResult &a = *r.audit;
     a.reference = referenceVisibility(c.scene, c.cam, cache);
@@ -210,10 +213,11 @@ void runCullingAudit(ViewContext &c, const TriangleLists &lists, std::vector<uin
 // A-buffer where the scene has transparency.
 void runOrderingAudit(ViewContext &c) {
     ViewResult &r = c.r;
-    if (c.ps.bspTree && r.audit.ran()) {
+    const BspTree *tree = c.ps.hasBspTree() && r.audit.ran() ? c.ps.bsp() : nullptr;
+    if (tree) {
         OrderingSettings os = c.s.orderingSettings;
         os.abufferMaxList = c.s.limits.maxABufferList;
-        r.ordering = analyzeOrdering(c.scene, c.cam, r.audit->reference, *c.ps.bspTree, c.ps.effects.abuffer, os);
+        r.ordering = analyzeOrdering(c.scene, c.cam, r.audit->reference, *tree, c.ps.effects.abuffer, os);
     } else {
         r.ordering.skip(c.ps.orderingReason.empty() ? "needs the reference visibility" : c.ps.orderingReason);
     }
@@ -275,8 +279,10 @@ PreparedScene prepareScene(const Scene &scene) {
     return ps;
 }
 
-bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err) {
+bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err, bool bspLater,
+                  bool *bspWanted) {
     PreparedScene ps = prepareScene(scene);
+    if (bspWanted) *bspWanted = false;
     ps.effects = planEffects(scene, s.effects);
     if (s.grid && !gridSkipReason(scene)) ps.grid = buildGrid(scene, s.gridSettings);
     const uint64_t tris = scene.objectTriangles.size();
@@ -285,6 +291,8 @@ bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *
     } else if (tris > s.orderingMaxTriangles) {
         ps.orderingReason = "scene has " + std::to_string(tris) + " triangles, more than --ordering-max-triangles " +
                             std::to_string(s.orderingMaxTriangles) + " (the BSP tree can grow quadratically)";
+    } else if (bspLater) {
+        if (bspWanted) *bspWanted = true;
     } else {
         ps.bspTree = std::make_unique<BspTree>(buildBspTree(scene));
     }
@@ -511,19 +519,29 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
     std::optional<tbb::global_control> threads;
     if (s.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(s.threads));
     PreparedScene ps;
-    if (!prepareScene(scene, s, &ps, err)) return false;
+    bool bspWanted = false;
+    if (!prepareScene(scene, s, &ps, err, true, &bspWanted)) return false;
     if (stopped()) {
         *err = kInterrupted;
         return false;
     }
+    // The ordering audit's BSP tree is built on a thread of its own while the views start: a view
+    // needs it only at its ordering audit, most of the way through, and the build is mostly serial
+    // (one core idle for its ~0.4 s on oa_thor otherwise). The tree does not depend on the timing,
+    // so neither do the results. Isolated: while its loops wait, the building thread takes only
+    // their tasks, never a view's (a view waiting for the tree on the thread that builds it would
+    // never return). The future's last copy waits for the build when it goes, so ps and the scene
+    // outlive it on every return path.
+    if (bspWanted)
+        ps.bspBuilding = std::async(std::launch::async, [&ps, &scene] {
+                             tbb::this_task_arena::isolate([&] {
+                                 runWithIeeeFp([&] { ps.bspTree = std::make_unique<BspTree>(buildBspTree(scene)); });
+                             });
+                         }).share();
     out->effects = ps.effects;
     out->raycast = ps.rays != nullptr;
     out->raySceneBuildMs = ps.raySceneBuildMs;
     out->orderingReason = ps.orderingReason;
-    if (ps.bspTree) {
-        out->bspTreeBuilt = true;
-        out->bspTree = ps.bspTree->stats;
-    }
     for (const Light &l : scene.lights) out->lightNames.push_back(l.name);
     if (scene.bsp) {
         AnalysisResult::BspSummary b;
@@ -555,7 +573,7 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
         std::lock_guard<std::mutex> lock(errMutex);
         if (!failed.exchange(true)) firstErr = e;
     };
-    tbb::parallel_for(size_t(0), views.size(), [&](size_t i) {
+    auto runView = [&](size_t i) {
         if (failed) return;
         if (stopped()) return failWith(kInterrupted);
         ViewResult v = analyzeView(ps, resolved[i], cams[i], s);
@@ -566,10 +584,17 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
             return failWith("view '" + v.spec.name + "': " + v.ordering->abuffer.error);
         if (onView && !onView(i, v, &e)) return failWith(e);
         out->views[i] = std::move(v);
-    });
+    };
+    // Under IEEE defaults on every thread, whatever used TBB first (common/fp_env.h).
+    runWithIeeeFp([&] { tbb::parallel_for(size_t(0), views.size(), runView); });
     if (failed) {
         *err = firstErr;
         return false;
+    }
+    if (ps.bspBuilding.valid()) ps.bspBuilding.get();  // done; a failed build's exception surfaces here
+    if (ps.bspTree) {
+        out->bspTreeBuilt = true;
+        out->bspTree = ps.bspTree->stats;
     }
     addDepthCurves(out);
     return true;

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <functional>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -77,17 +78,31 @@ struct PreparedScene {
     ObjectBvh bvh;
     Grid grid;                       // when the grid stage can run (gridSkipReason is null)
     std::unique_ptr<BspTree> bspTree; // the ordering audit's BSP tree (view-independent)
+    // While valid, bspTree is being built on another thread (analyzeScene starts the views
+    // alongside it): read the tree through bsp(), which waits for it.
+    std::shared_future<void> bspBuilding;
     std::string orderingReason;      // why the ordering audit does not run (empty: it does)
     std::unique_ptr<RayScene> rays;  // Embree scene over every analysed triangle (raycast on)
     double raySceneBuildMs = 0;
     SceneEffectsData effectsData;
     EffectPlan effects;
+
+    // Whether the ordering audit has a tree (built or being built).
+    bool hasBspTree() const { return bspTree || bspBuilding.valid(); }
+    // The tree once built (null: none, or its build failed: analyzeScene reports why).
+    const BspTree *bsp() const {
+        if (bspBuilding.valid()) bspBuilding.wait();
+        return bspTree.get();
+    }
 };
 // Without ray casting (tests of the rasterizing stages).
 PreparedScene prepareScene(const Scene &scene);
 // As the settings say: the Embree scene and the effects plan when raycast is on. False + message
 // when Embree fails.
-bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err);
+// bspLater: the BSP tree is not built; *bspWanted (optional) says whether it is wanted (the caller
+// builds it, as analyzeScene does alongside the first views).
+bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err,
+                  bool bspLater = false, bool *bspWanted = nullptr);
 
 // The view after settings' overrides, validated; false with a message naming the view and a fix.
 bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, Camera *cam, std::string *err);

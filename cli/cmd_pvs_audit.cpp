@@ -13,6 +13,7 @@
 #include "analysis/load/load.h"
 #include "cli/command_table.h"
 #include "cli/commands.h"
+#include "common/fp_env.h"
 #include "reports/pvs_audit_report.h"
 #include "reports/report.h"
 
@@ -91,7 +92,9 @@ int runPvsAudit(const PvsAuditOptions &o, const Scene &scene, const PvsAuditSett
                          elapsed / double(done) * double(total - done));
         };
     std::string err;
-    const bool ok = auditPvs(scene, s, result, &err);
+    // Under IEEE defaults on every thread, whatever used TBB first (common/fp_env.h).
+    bool ok = false;
+    runWithIeeeFp([&] { ok = auditPvs(scene, s, result, &err); });
     if (tty) std::fprintf(stderr, "\n");
     if (!ok) {
         if (interrupted()) return interruptedExit(outName);

@@ -1,17 +1,23 @@
 // Exact cases for the frustum, backface and clip stages and the pipeline that joins them.
 #include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
+#include <xmmintrin.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <random>
+#include <set>
 
 #include "analysis/stages/backface.h"
 #include "analysis/load/demo.h"
 #include "tests/test_util.h"
 #include "analysis/stages/frustum.h"
 #include "analysis/pipeline.h"
+#include "common/fp_env.h"
 #include "render/camera.h"
 #include "render/clip_vertices.h"
 
@@ -481,6 +487,49 @@ TEST(Pipeline, CountsAndImagesAreIdenticalAcrossThreadCounts) {
             EXPECT_EQ(results[k].views[v].zbuffer.fragments, results[0].views[v].zbuffer.fragments);
             EXPECT_EQ(results[k].views[v].zbuffer.histogram, results[0].views[v].zbuffer.histogram);
         }
+}
+
+// The views compute under IEEE 754 defaults on every thread (common/fp_env.h) even when the
+// process's first TBB user ran with flush-to-zero and denormals-are-zero on, as Embree's scene
+// build does: TBB's default context keeps the first user's settings for every later loop.
+TEST(Pipeline, ViewsRunUnderIeeeDefaultsWhateverUsedTbbFirst) {
+    constexpr unsigned kFtzDaz = 0x8040u, kStatus = 0x3Fu;
+    const unsigned saved = _mm_getcsr();
+    _mm_setcsr(saved | kFtzDaz);
+    std::atomic<unsigned> first{0};
+    tbb::parallel_for(0, 4, [&](int) { first |= _mm_getcsr() & kFtzDaz; });  // this process's first TBB use
+    _mm_setcsr(saved);
+    EXPECT_EQ(first.load(), kFtzDaz);
+
+    std::mutex m;
+    std::set<unsigned> controls;  // MXCSR without its status flags, per task
+    std::vector<double> halves;
+    auto record = [&] {
+        volatile double tiny = 0x1p-1070;  // subnormal
+        const double half = tiny * 0.5;    // 0x1p-1071 under IEEE defaults, 0 flushed
+        std::lock_guard<std::mutex> lock(m);
+        controls.insert(_mm_getcsr() & ~kStatus);
+        halves.push_back(half);
+    };
+    const Scene scene = demoScene();
+    PipelineSettings s;
+    s.threads = 2;
+    AnalysisResult r;
+    std::string err;
+    ASSERT_TRUE(analyzeScene(
+        scene, scene.views, s,
+        [&](size_t, ViewResult &, std::string *) {
+            record();
+            return true;
+        },
+        &r, &err))
+        << err;
+    // Nested loops inside runWithIeeeFp too (the raycast's bands run nested in a view).
+    runWithIeeeFp([&] { tbb::parallel_for(0, 8, [&](int) { tbb::parallel_for(0, 8, [&](int) { record(); }); }); });
+    EXPECT_EQ(controls, std::set<unsigned>{kIeeeMxcsr});
+    EXPECT_EQ(halves.size(), scene.views.size() + 64);
+    for (double h : halves) EXPECT_EQ(h, 0x1p-1071);
+    EXPECT_EQ(_mm_getcsr() & ~kStatus, saved & ~kStatus);  // the caller's settings back
 }
 
 TEST(Pipeline, InvalidViewsAreRefusedBeforeAnyWork) {
