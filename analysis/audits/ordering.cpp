@@ -532,12 +532,13 @@ struct BandedDraw {
         uint64_t n = 0, pass = 0, cover = 0;
         auto write = [&](uint32_t pixel, double d, uint32_t current) {
             if constexpr (kPaint || !kDepthTest) ids[pixel] = current;
-            if constexpr (!kDepthTest) {
-            } else if (double &old = z[pixel - p0]; d < old) {
-                cover += old == std::numeric_limits<double>::infinity();
-                old = d;
-                if (keepIds) ids[pixel] = current;
-                ++pass;
+            if constexpr (kDepthTest) {
+                if (double &old = z[pixel - p0]; d < old) {
+                    cover += old == std::numeric_limits<double>::infinity();
+                    old = d;
+                    if (keepIds) ids[pixel] = current;
+                    ++pass;
+                }
             }
         };
         for (uint32_t i = bandBegin[b]; i < bandBegin[b + 1]; ++i) {
