@@ -279,7 +279,7 @@ PreparedScene prepareScene(const Scene &scene) {
     return ps;
 }
 
-bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err, bool bspLater,
+bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err,
                   bool *bspWanted) {
     PreparedScene ps = prepareScene(scene);
     if (bspWanted) *bspWanted = false;
@@ -291,8 +291,8 @@ bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *
     } else if (tris > s.orderingMaxTriangles) {
         ps.orderingReason = "scene has " + std::to_string(tris) + " triangles, more than --ordering-max-triangles " +
                             std::to_string(s.orderingMaxTriangles) + " (the BSP tree can grow quadratically)";
-    } else if (bspLater) {
-        if (bspWanted) *bspWanted = true;
+    } else if (bspWanted) {
+        *bspWanted = true;
     } else {
         ps.bspTree = std::make_unique<BspTree>(buildBspTree(scene));
     }
@@ -520,7 +520,7 @@ bool analyzeScene(const Scene &scene, const std::vector<ViewSpec> &views, const 
     if (s.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(s.threads));
     PreparedScene ps;
     bool bspWanted = false;
-    if (!prepareScene(scene, s, &ps, err, true, &bspWanted)) return false;
+    if (!prepareScene(scene, s, &ps, err, &bspWanted)) return false;
     if (stopped()) {
         *err = kInterrupted;
         return false;

@@ -99,10 +99,10 @@ struct PreparedScene {
 PreparedScene prepareScene(const Scene &scene);
 // As the settings say: the Embree scene and the effects plan when raycast is on. False + message
 // when Embree fails.
-// bspLater: the BSP tree is not built; *bspWanted (optional) says whether it is wanted (the caller
-// builds it, as analyzeScene does alongside the first views).
+// With bspWanted, the BSP tree is not built: *bspWanted says whether it is wanted (the caller builds
+// it, as analyzeScene does alongside the first views).
 bool prepareScene(const Scene &scene, const PipelineSettings &s, PreparedScene *out, std::string *err,
-                  bool bspLater = false, bool *bspWanted = nullptr);
+                  bool *bspWanted = nullptr);
 
 // The view after settings' overrides, validated; false with a message naming the view and a fix.
 bool resolveView(const ViewSpec &in, const PipelineSettings &s, ViewSpec *out, Camera *cam, std::string *err);
