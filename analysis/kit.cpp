@@ -606,7 +606,9 @@ StageAnswer answerPainter(const KitView &v, const PainterInput &in, PainterKey k
     for (size_t i = 0; i < order.size(); ++i) items[i].source = order[i];
     StageAnswer a;
     a.stage = Stage::painter;
-    const DrawStats st = drawInOrder(ov, items, false, nullptr, nullptr, &a.ids);
+    UninitVector<uint32_t> ids;
+    const DrawStats st = drawInOrder(ov, items, false, nullptr, nullptr, &ids);
+    a.ids.assign(ids.begin(), ids.end());
     OJson &j = a.answer;
     j["triangles_drawn"] = order.size();
     j["fragments"] = st.fragments;

@@ -527,7 +527,7 @@ TEST(AssignmentKit, AnswersEqualThePipelinesNumbers) {
         EXPECT_EQ(pa["triangles_drawn"].get<uint64_t>(), vr.ordering->painter.trianglesDrawn);
         EXPECT_EQ(pa["fragments"].get<uint64_t>(), vr.ordering->painter.fragments);
         EXPECT_EQ(pa["covered_pixels"].get<uint64_t>(), vr.ordering->painter.coveredPixels);
-        EXPECT_TRUE(ans[3].ids == vr.ordering->painter.id) << vr.spec.name;
+        EXPECT_TRUE(std::ranges::equal(ans[3].ids, vr.ordering->painter.id)) << vr.spec.name;
     }
 }
 

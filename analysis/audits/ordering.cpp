@@ -67,7 +67,7 @@ struct OrderSink {
     const BspViewPlanes *planes;
     bool depthTest;
     std::vector<double> &depth;
-    std::vector<uint32_t> &id;
+    UninitVector<uint32_t> &id;
     uint32_t current = 0;
     uint32_t piece = UINT32_MAX;
     uint64_t fragments = 0, passes = 0;
@@ -126,7 +126,7 @@ OrderingView prepareOrderingView(const Scene &scene, const Camera &cam, const Re
 }
 
 PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
-                                     const std::vector<uint32_t> &ids, bool keepClasses) {
+                                     std::span<const uint32_t> ids, bool keepClasses) {
     PixelComparison c;
     if (keepClasses) c.cls.assign(ids.size(), kOrderRight);
     auto classify = [&](size_t p, uint8_t k) {
@@ -454,7 +454,7 @@ struct DrawJob {
     const ItemFragments *sel = nullptr;  // its listed items' fragments; null: every item whole
     bool depthTest = false;
     bool reverse = false;                // the items from the last to the first
-    std::vector<uint32_t> *idsOut = nullptr;
+    UninitVector<uint32_t> *idsOut = nullptr;
     DrawStats stats;                     // out; stats.ms is this draw's own time
     // With depthTest: the same pass is also the draw without the depth test in the same order
     // (every fragment writes its id: the painter's draw), its ids in idsOut (the depth-tested
@@ -463,7 +463,7 @@ struct DrawJob {
     DrawStats paintStats;                // out, with paint
 };
 DrawJob drawJob(const std::vector<DrawItem> &items, const ItemFragments *sel, bool depthTest, bool reverse,
-                std::vector<uint32_t> *idsOut) {
+                UninitVector<uint32_t> *idsOut) {
     DrawJob job;
     job.items = &items;
     job.sel = sel;
@@ -486,8 +486,11 @@ struct BandedDraw {
     std::vector<DrawRun> runs;
     std::vector<uint32_t> firstBand, bandBegin, bandRuns;
     std::vector<double> depth;  // one band's, indexed by pixel - the band's first pixel
-    std::vector<uint32_t> id;
+    // Whole-screen ids, each band's rows cleared when that band is drawn (in the core's cache, not
+    // in a pass over 8 MB before the draw); empty when neither the caller nor the counts need them.
+    UninitVector<uint32_t> id;
     uint64_t fragments = 0, passes = 0, covered = 0;
+    uint64_t painted = 0;       // pixels with an id, counted band by band (without the depth test)
     double ms = 0;
 
     void prepare(const OrderingView &v, const DrawJob &job, size_t pixels, size_t bandPixels, size_t bands) {
@@ -495,7 +498,7 @@ struct BandedDraw {
         const std::vector<DrawItem> &items = *job.items;
         runs.clear();
         firstBand.clear();
-        fragments = passes = covered = 0;
+        fragments = passes = covered = painted = 0;
         auto addRun = [&](uint64_t at, uint64_t end, uint32_t current, uint32_t firstPixel, uint32_t lastPixel) {
             runs.push_back({at, end, current, uint32_t(lastPixel / bandPixels)});
             firstBand.push_back(uint32_t(firstPixel / bandPixels));
@@ -518,7 +521,7 @@ struct BandedDraw {
                   bandBegin, bandRuns);
         if (job.depthTest) depth.resize(bandPixels);
         id.clear();
-        if (!job.depthTest || job.idsOut) id.resize(pixels, 0);
+        if (!job.depthTest || job.idsOut) id.resize(pixels);  // uninitialized: drawBand clears its rows
     }
 
     // kPaint (with kDepthTest): every fragment also writes its id, as the draw without the test.
@@ -529,6 +532,7 @@ struct BandedDraw {
         uint32_t *ids = id.data();
         double *z = depth.data();  // the band's: pixel - p0
         if constexpr (kDepthTest) std::fill(depth.begin(), depth.end(), std::numeric_limits<double>::infinity());
+        if (!id.empty()) std::fill(ids + p0, ids + p1, 0u);
         uint64_t n = 0, pass = 0, cover = 0;
         auto write = [&](uint32_t pixel, double d, uint32_t current) {
             if constexpr (kPaint || !kDepthTest) ids[pixel] = current;
@@ -557,6 +561,11 @@ struct BandedDraw {
         fragments += n;
         passes += pass;
         covered += cover;
+        if constexpr (kPaint || !kDepthTest) {
+            uint64_t with = 0;
+            for (size_t p = p0; p < p1; ++p) with += ids[p] != 0;
+            painted += with;
+        }
     }
 
     // The job's stats (and, with paint, job.paintStats); ms is left to the caller.
@@ -566,10 +575,10 @@ struct BandedDraw {
             st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
         };
         // Without the depth test every fragment writes, and the ids count the covered pixels.
-        auto painted = [&]() {
+        auto paintedStats = [&]() {
             DrawStats st;
             st.fragments = st.depthPasses = fragments;
-            for (uint32_t i : id) st.coveredPixels += i != 0;
+            st.coveredPixels = painted;
             ratios(st);
             return st;
         };
@@ -579,9 +588,9 @@ struct BandedDraw {
             st.depthPasses = passes;
             st.coveredPixels = covered;
             ratios(st);
-            if (job.paint) job.paintStats = painted();
+            if (job.paint) job.paintStats = paintedStats();
         } else {
-            st = painted();
+            st = paintedStats();
         }
         if (job.idsOut) *job.idsOut = std::move(id);
         return st;
@@ -623,7 +632,7 @@ void drawCached(const OrderingView &v, std::span<DrawJob> jobs) {
 
 // One draw: the items in order, or (reverse) from the last to the first.
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
-                     const ItemFragments *sel, std::vector<uint32_t> *idsOut, bool reverse = false) {
+                     const ItemFragments *sel, UninitVector<uint32_t> *idsOut, bool reverse = false) {
     DrawJob job = drawJob(items, sel, depthTest, reverse, idsOut);
     drawCached(v, std::span<DrawJob>(&job, 1));
     return job.stats;
@@ -638,7 +647,7 @@ bool hasConstrainedPiece(const std::vector<DrawItem> &items, const BspTree *tree
 }  // namespace
 
 DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest, const BspTree *tree,
-                      const BspViewPlanes *planes, std::vector<uint32_t> *idsOut) {
+                      const BspViewPlanes *planes, UninitVector<uint32_t> *idsOut) {
     const Stopwatch t0;
     if (v.fragments) {
         thread_local ItemFragments sel;
@@ -664,7 +673,7 @@ DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items,
     }
     const size_t pixels = size_t(std::max(v.cam.width, 0)) * size_t(std::max(v.cam.height, 0));
     std::vector<double> depth(depthTest ? pixels : 0, std::numeric_limits<double>::infinity());
-    std::vector<uint32_t> id(pixels, 0);
+    UninitVector<uint32_t> id(pixels, 0);
     const PixelRays rays(v.cam);
     OrderSink sink{v, rays, itemOf, items, tree, planes, depthTest, depth, id};
     forEachFragment(list, v.cam.width, v.cam.height, v.cam.orthographic, sink);
@@ -1039,7 +1048,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     // six draws run band by band together in five passes (the painter's and the back-to-front
     // one are one pass over the same fragments), and the submitted draw is also the z-buffer row
     // below (kept ids).
-    std::vector<uint32_t> submittedIds;
+    UninitVector<uint32_t> submittedIds;
     {
         std::vector<DrawItem> backToFront;
         std::vector<uint32_t> painterSorted;

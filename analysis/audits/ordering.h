@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@
 #include "analysis/audits/bsp_tree.h"
 #include "analysis/effects_plan.h"
 #include "analysis/scene.h"
+#include "common/uninit_vector.h"
 #include "render/abuffer.h"
 #include "render/camera.h"
 #include "render/raster.h"
@@ -68,7 +70,7 @@ struct PixelComparison {
                                //   (empty when the caller asked for the counts only)
 };
 PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
-                                     const std::vector<uint32_t> &ids, bool keepClasses = true);
+                                     std::span<const uint32_t> ids, bool keepClasses = true);
 
 // ---- Painter's algorithm ------------------------------------------------------------------------
 
@@ -119,7 +121,7 @@ struct PainterResult {
     uint64_t edgePixels = 0;
     double sortMs = 0, drawMs = 0;    // sorting (O(n log n)), drawing
     uint64_t memoryBytes = 0;         // id buffer + sort keys
-    std::vector<uint32_t> id;         // per pixel, 1 + source (the painter's picture)
+    UninitVector<uint32_t> id;        // per pixel, 1 + source (the painter's picture)
     std::vector<uint8_t> cls;         // per pixel, kOrder* (NAME.painter_errors.png)
     OverlapTests overlaps;            // filled when requested
 };
@@ -166,7 +168,7 @@ struct DrawStats {
 // equal depths stays) or without (the last drawn shows). `tree`/`planes` are needed when an item is
 // a piece. `ids` (optional) receives 1 + source per pixel.
 DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest, const BspTree *tree,
-                      const BspViewPlanes *planes, std::vector<uint32_t> *ids);
+                      const BspViewPlanes *planes, UninitVector<uint32_t> *ids);
 
 struct OrderOverdraw {
     std::string order;  // "submitted", "back_to_front", "front_to_back_objects", "bsp_front_to_back"
@@ -184,7 +186,7 @@ struct BspViewResult {
     DrawStats frontToBack;            // with the depth test: the least overdraw
     double traverseMs = 0;            // one traversal (eye side at each node, exact)
     std::vector<uint8_t> cls;         // per pixel, kOrder*
-    std::vector<uint32_t> id;         // per pixel, 1 + source, back to front without depth test
+    UninitVector<uint32_t> id;        // per pixel, 1 + source, back to front without depth test
 };
 BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree);
 
@@ -221,9 +223,9 @@ struct OrderingResult {
     double ms = 0;
     // Frees the per-pixel buffers once the images are written (the statistics stay).
     void releasePixels() {
-        std::vector<uint32_t>().swap(painter.id);
+        UninitVector<uint32_t>().swap(painter.id);
         std::vector<uint8_t>().swap(painter.cls);
-        std::vector<uint32_t>().swap(bsp.id);
+        UninitVector<uint32_t>().swap(bsp.id);
         std::vector<uint8_t>().swap(bsp.cls);
         std::vector<uint32_t>().swap(scanline.id);
         std::vector<uint8_t>().swap(abuffer.rgb);
