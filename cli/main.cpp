@@ -1,9 +1,11 @@
 #include <climits>
 #include <cstdint>
 #include <cstdlib>
+#include <initializer_list>
 
 #include <malloc.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "cli/commands.h"
@@ -18,13 +20,17 @@ namespace {
 // kHeapReserve now (address space only: pages are faulted in as they are touched, as before) and
 // that range is advised MADV_HUGEPAGE. One arena, so the other threads' blocks come from it too (a
 // thread's own arena is mapped apart, in 4 KiB pages; per-thread caches still serve small blocks
-// without the lock). Only a hint: where THP is "never", or the heap cannot grow, nothing changes,
+// without the lock). Only a hint: where THP is "never", the heap cannot grow, or the process runs
+// under a limit on its address space or data size, nothing changes,
 // and past kHeapReserve the heap grows in 4 KiB pages again. Measured on oa_thor spawns, 34-view
 // shard at 1080p, 2 threads, alternating three times: 5.80-6.12 -> 5.13-5.19 s wall, user CPU
 // 9.97-10.53 -> 8.46-8.67 s, minor faults 112-117k -> 1.9-2.1k, peak RSS unchanged.
 void heapOnHugePages() {
     constexpr size_t kHeapReserve = size_t(1) << 30;
     constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+    // Under a limit on address space or data (ulimit -v, -d) the reserve would spend a GiB of it.
+    for (int limit : {RLIMIT_AS, RLIMIT_DATA})
+        if (rlimit r{}; getrlimit(limit, &r) == 0 && r.rlim_cur != RLIM_INFINITY) return;
     mallopt(M_ARENA_MAX, 1);
     mallopt(M_TOP_PAD, int(kHeapReserve));
     const uintptr_t before = reinterpret_cast<uintptr_t>(sbrk(0));
