@@ -20,9 +20,10 @@
 #include <string>
 #include <vector>
 
+#include "analysis/audits/ordering.h"
 #include "analysis/effects_plan.h"
 #include "analysis/load/load.h"
-#include "analysis/audits/ordering.h"
+#include "common/process_heap.h"
 
 using namespace va;
 
@@ -55,6 +56,7 @@ Scene tiled(const Scene &scene, int copies) {
 }  // namespace
 
 int main(int argc, char **argv) {
+    va::setUpProcessHeap();  // the allocator visaudit runs with
     std::string path = std::string(VISAUDIT_SOURCE_DIR) + "/data/openarena/pak6-patch088.pk3:maps/oa_thor.bsp";
     int reps = 3, nViews = 2, tile = 1;
     for (int i = 1; i < argc; ++i) {

@@ -45,10 +45,11 @@
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
-#include "analysis/stages/backface.h"
-#include "bench/bench_scene.h"
-#include "analysis/stages/frustum.h"
 #include "analysis/load/load.h"
+#include "analysis/stages/backface.h"
+#include "analysis/stages/frustum.h"
+#include "bench/bench_scene.h"
+#include "common/process_heap.h"
 #include "render/clip.h"
 #include "render/raster.h"
 #include "render/raycast.h"
@@ -812,6 +813,7 @@ int Bench::sectionScaling() {
 }
 
 int main(int argc, char **argv) {
+    va::setUpProcessHeap();  // the allocator visaudit runs with
     Options o;
     const std::vector<std::string> allSections = {"zbuffer", "llvmpipe", "raycast", "pipeline", "load",
                                                   "analyze",  "level",    "scaling"};

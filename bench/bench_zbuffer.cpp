@@ -21,10 +21,12 @@
 #include <tbb/global_control.h>
 
 #include "bench/bench_scene.h"
+#include "common/process_heap.h"
 #include "render/clip.h"
 #include "render/raster.h"
 
 int main(int argc, char **argv) {
+    va::setUpProcessHeap();  // the allocator visaudit runs with
     int reps = 9;
     int tileShift = 0;
     int only = -1;  // --only K: just configuration K (0-based, table order), e.g. for a profiler
