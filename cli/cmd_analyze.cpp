@@ -13,8 +13,6 @@
 
 #include <unistd.h>
 
-#include <tbb/global_control.h>
-
 #include <nlohmann/json.hpp>
 
 #include "analysis/level_map.h"
@@ -261,9 +259,6 @@ int analyzeToReport(const AnalyzeOptions &o,
     result.loadMs = loadMs;
     OutputTimings outputMs;
     for (double ms : imagesMs) outputMs.imagesMs += ms;
-    // The report's views are built in parallel: on --threads as many threads as the analysis.
-    std::optional<tbb::global_control> threads;
-    if (settings.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, size_t(settings.threads));
     const Stopwatch r0;
     *report = reportJson(result, imageSet);
     outputMs.reportMs = r0.ms();

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include <tbb/parallel_for.h>
 
 #include "reports/findings.h"
 #include "reports/ordering_images.h"
@@ -495,13 +494,11 @@ nlohmann::ordered_json reportJson(const AnalysisResult &r, ImageSet images) {
                   {"views_total", r.shard.viewsTotal ? r.shard.viewsTotal : r.views.size()}};
     j["depth_curves"] = depthCurvesJson(r.depthCurves);
     const std::vector<std::string> bases = imageBaseNames(r.views);
-    // Each view's JSON depends on that view alone: built in parallel (the run's threads, once the
-    // views are analysed), then appended in order.
-    std::vector<Json> each(r.views.size());
-    tbb::parallel_for(size_t(0), r.views.size(),
-                      [&](size_t i) { each[i] = viewJson(r.views[i], bases[i], r.lightNames, images); });
+    // One view after the other, each moved in. Not in parallel: the JSON's small blocks all come
+    // from the process's one malloc arena (common/process_heap.h), and two threads building at once
+    // took turns on its lock: 487 ms for the 171 views of the oa_thor level run against 75 ms here.
     Json views = Json::array();
-    for (Json &v : each) views.push_back(std::move(v));
+    for (size_t i = 0; i < r.views.size(); ++i) views.push_back(viewJson(r.views[i], bases[i], r.lightNames, images));
     j["views"] = std::move(views);
     j["totals"] = reportTotals(j["views"]);
     addFindings(&j);
