@@ -26,6 +26,7 @@
 #include <libdeflate.h>
 #include <zlib.h>
 
+#include "common/uninit_vector.h"
 #include "reports/font.h"
 #include "reports/legend.h"
 #include "reports/palette_image.h"
@@ -604,7 +605,7 @@ bool writeViewImages(const ViewResult &view, const std::string &dir, const std::
 
     // BASE.depth.exr: view depth as float, +inf where nothing was drawn.
     if (want("depth_exr")) {
-        std::vector<float> z(n);
+        UninitVector<float> z(n);  // every element written below: no clear first
         for (size_t i = 0; i < n; ++i) z[i] = float(zb.depth[i]);
         if (!writeExr(prefix + names.depthExr, W, H, "Z", true, z.data(), err)) return false;
     }
