@@ -23,11 +23,12 @@ namespace {
 // that range is advised MADV_HUGEPAGE. One arena, so the other threads' blocks come from it too (a
 // thread's own arena is mapped apart, in 4 KiB pages; per-thread caches still serve small blocks
 // without the lock, but work made of little else but small allocations takes turns on it: the
-// report's JSON is built on one thread for that, reports/report_json.cpp). Only a hint: where THP is "never", the heap cannot grow, or the process runs
-// under a limit on its address space or data size, nothing changes, and past kHeapReserve the heap
-// grows in 4 KiB pages again. Measured on oa_thor spawns, 34-view shard at 1080p, 2 threads,
-// alternating three times: 5.80-6.12 -> 5.13-5.19 s wall, user CPU 9.97-10.53 -> 8.46-8.67 s,
-// minor faults 112-117k -> 1.9-2.1k, peak RSS unchanged.
+// report's JSON is built on one thread for that, reports/report_json.cpp). Only a hint: where THP
+// is "never", the heap cannot grow, or the process runs under a limit on its address space or data
+// size, nothing changes, and past kHeapReserve the heap grows in 4 KiB pages again. Measured on
+// oa_thor spawns, 34-view shard at 1080p, 2 threads, alternating three times: 5.80-6.12 ->
+// 5.13-5.19 s wall, user CPU 9.97-10.53 -> 8.46-8.67 s, minor faults 112-117k -> 1.9-2.1k, peak RSS
+// unchanged.
 void heapOnHugePages() {
     constexpr size_t kHeapReserve = size_t(1) << 30;
     constexpr uintptr_t kHuge = uintptr_t(2) << 20;

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-
 #include "reports/findings.h"
 #include "reports/ordering_images.h"
 #include "reports/report.h"
