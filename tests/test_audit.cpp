@@ -759,6 +759,84 @@ TEST(AuditEdgeDistance, MemoEqualsFromScratchBitForBit) {
     }
 }
 
+// EdgeDistanceMemo::nearEdge gives operator()'s nearEdge for every input: at the pixel centers of
+// random triangles (some reaching behind the eye, some edge-on; both projections), and at points
+// bisected onto the line where the answer flips between "inside" and "near an edge", where the
+// bounds of its shortcut must leave the answer to operator(). Mutations: dropping the slack or the
+// tolerance's factor, or answering false once the edges pass, fail it.
+TEST(AuditEdgeDistance, NearEdgeShortcutGivesTheFullAnswer) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> U(-4, 4);
+    std::vector<std::array<Vec3, 3>> tris;
+    for (int i = 0; i < 40; ++i) {
+        const Vec3 c{U(rng), U(rng), U(rng) - 6};
+        std::array<Vec3, 3> t;
+        for (auto &p : t) p = c + Vec3{U(rng), U(rng), U(rng) * (i % 5 == 0 ? 3 : 0.5)};
+        if (i % 7 == 0) t[2] = t[0] + (t[1] - t[0]) * 0.5;  // degenerate: no area
+        tris.push_back(t);
+    }
+    // Four cut by the near plane (0.1 in front of the eye at z = 1) and four by the far one (1000).
+    for (int i = 0; i < 4; ++i) {
+        const double a = 0.4 * i;
+        tris.push_back({Vec3{-3 + a, -2, 0.95}, Vec3{3, -2 + a, 0.85}, Vec3{a, 3, -9}});
+        tris.push_back({Vec3{-400 - 50 * a, -300, -900}, Vec3{500, -350 + a, -1100}, Vec3{a, 450, -950 - 100 * a}});
+    }
+    const Scene scene = testing_util::looseTriangles(tris, true);
+    for (bool ortho : {false, true}) {
+        CameraSpec cs;
+        cs.eye = {0.3, -0.2, 1};
+        cs.target = {0, 0, -6};
+        cs.orthographic = ortho;
+        cs.width = 64;
+        cs.height = 48;
+        Camera cam;
+        std::string err;
+        ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+        const Vec3 origin{0.5, 0.25, -2};
+        EdgeDistanceMemo shortcut(scene, cam, origin), full(scene, cam, origin);
+        uint64_t inside = 0, near = 0, flips = 0;
+        auto clearlyInside = [&](uint32_t t, double px, double py) {
+            const EdgeDistance e = full(t, px, py);
+            return e.signedPx > e.tolerancePx;
+        };
+        for (uint32_t t = 0; t < tris.size(); ++t)
+            for (int y = 0; y < cs.height; ++y) {
+                const double py = y + 0.5;
+                bool last = false;
+                for (int x = 0; x < cs.width; ++x) {
+                    const double px = x + 0.5;
+                    const bool expect = full(t, px, py).nearEdge;
+                    ASSERT_EQ(shortcut.nearEdge(t, px, py), expect) << ortho << " " << t << " " << px << " " << py;
+                    const bool in = clearlyInside(t, px, py);
+                    inside += in;
+                    near += expect;
+                    if (x > 0 && in != last) {
+                        // Bisect between the two centers onto where "clearly inside" ends (the
+                        // answer flips there), then ask on both sides of it.
+                        double lo = px - 1, hi = px;
+                        for (int i = 0; i < 80 && std::nextafter(lo, hi) < hi; ++i) {
+                            const double mid = lo + (hi - lo) / 2;
+                            (clearlyInside(t, mid, py) == last ? lo : hi) = mid;
+                        }
+                        for (double q : {lo, hi, std::nextafter(lo, -1e300), std::nextafter(hi, 1e300)}) {
+                            const bool e = full(t, q, py).nearEdge;
+                            near += e;
+                            ASSERT_EQ(shortcut.nearEdge(t, q, py), e) << ortho << " " << t << " " << q << " " << py;
+                            // Another triangle at the same point in between (the memo keeps two).
+                            const uint32_t o = uint32_t((t + 1) % tris.size());
+                            ASSERT_EQ(shortcut.nearEdge(o, q, py), full(o, q, py).nearEdge);
+                        }
+                        ++flips;
+                    }
+                    last = in;
+                }
+            }
+        EXPECT_GT(inside, 1000u) << ortho;
+        EXPECT_GT(near, 100u) << ortho;
+        EXPECT_GT(flips, 100u) << ortho;
+    }
+}
+
 // ---- Watertightness ----------------------------------------------------------------------------
 
 // Dense random rays through a closed UV sphere from outside never miss when their line passes the

@@ -437,6 +437,12 @@ struct EdgeTerms {
     double E[3] = {}; // perspective: edge k's float error of f before the factor |D|
     double gp = 0;    // |gradient| of the depth plane
     RayDepthTerms depth;  // perspective
+    // Perspective, for EdgeDistanceMemo::nearEdge: edge k's f(p) = C . D(p) is affine in the pixel,
+    // f = fa px + fb py + f0 exactly, so its gradient is (fa, fb) and g = |(fa, fb)| (the value the
+    // three rays' differences approximate); |Cx| |Dx(p)| + |Cy| |Dy(p)| + |Cz| <= mA px + mB py + mC
+    // bounds the terms of f's dot product (its rounding). fast: these are usable (finite, g > 0).
+    double g[3] = {}, mA[3] = {}, mB[3] = {}, mC[3] = {};
+    bool fast = false;
 };
 
 namespace {
@@ -467,9 +473,51 @@ EdgeTerms edgeTerms(const ViewTriangle &v, const Camera &cam) {
             e.E[k] = edgeErrorFactor(v, e.q, i, j);
         }
         e.depth = rayDepthTerms(v, e.q);
+        // D(p) = ((2 px / W - 1) / sx, (1 - 2 py / H) / sy, -1) (viewRayThroughPixel).
+        const double W = double(cam.width), H = double(cam.height);
+        e.fast = e.sigma != 0 && v.plane.valid && W > 0 && H > 0;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 &C = e.C[k];
+            const double fa = 2 * C.x / (W * cam.sx), fb = -2 * C.y / (H * cam.sy);
+            e.g[k] = std::hypot(fa, fb);
+            e.mA[k] = std::fabs(fa);
+            e.mB[k] = std::fabs(fb);
+            e.mC[k] = std::fabs(C.x / cam.sx) + std::fabs(C.y / cam.sy) + std::fabs(C.z);
+            e.fast = e.fast && e.g[k] > 0 && std::isfinite(e.g[k]) && std::isfinite(e.mC[k]) &&
+                     std::isfinite(e.E[k]) && std::isfinite(e.mA[k] + e.mB[k]);
+        }
     }
     e.gp = std::hypot(v.plane.a, v.plane.b);
     return e;
+}
+
+// The near and far plane constraints of edgeDistance (below), each given to take(s, tolerance).
+template <class Take>
+void nearFarConstraints(const ViewTriangle &v, const EdgeTerms &e, const Camera &cam, const ViewRay &r, double px,
+                        double py, const double *q, Take &&take) {
+    // The near and far planes cut the triangle along lines of constant depth: perspective
+    // 1/d = plane(p) (near: 1/near - plane >= 0, far: plane - 1/far >= 0), orthographic d = plane(p).
+    // The z-buffer clips exactly in double and snaps (kSnapEdgeTolerancePx); the ray caster limits
+    // t to [float(near), float(far)] and computes t in float (rayDepthError).
+    const double pv = evalDepthPlane(v.plane, px, py);
+    const double gp = e.gp;
+    const double d = cam.orthographic ? pv : 1 / pv;
+    const double dErr =
+        std::isfinite(d) && d > 0 ? rayDepthError(e.perspective ? e.depth : rayDepthTerms(v, q), r, d) : 0;
+    for (int side = 0; side < 2; ++side) {
+        const double limit = side == 0 ? cam.nearZ : cam.farZ;
+        double s, tolValue;
+        if (cam.orthographic) {
+            s = side == 0 ? pv - limit : limit - pv;
+            tolValue = dErr + kFloatU * limit;
+        } else {
+            s = side == 0 ? 1 / limit - pv : pv - 1 / limit;
+            tolValue = (dErr + kFloatU * limit) / (limit * limit);  // d(1/d) = dd / d^2
+        }
+        if (gp > 0) take(s / gp, kSnapEdgeTolerancePx + tolValue / gp);
+        else take(s >= 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
+                  kSnapEdgeTolerancePx);
+    }
 }
 
 EdgeDistance edgeDistance(const ViewTriangle &v, const EdgeTerms &e, const Camera &cam, const PixelRayTriple &rays,
@@ -524,29 +572,7 @@ EdgeDistance edgeDistance(const ViewTriangle &v, const EdgeTerms &e, const Camer
                   kSnapEdgeTolerancePx);
     }
 
-    // The near and far planes cut the triangle along lines of constant depth: perspective
-    // 1/d = plane(p) (near: 1/near - plane >= 0, far: plane - 1/far >= 0), orthographic d = plane(p).
-    // The z-buffer clips exactly in double and snaps (kSnapEdgeTolerancePx); the ray caster limits
-    // t to [float(near), float(far)] and computes t in float (rayDepthError).
-    const double pv = evalDepthPlane(v.plane, px, py);
-    const double gp = e.gp;
-    const double d = cam.orthographic ? pv : 1 / pv;
-    const double dErr =
-        std::isfinite(d) && d > 0 ? rayDepthError(e.perspective ? e.depth : rayDepthTerms(v, q), r, d) : 0;
-    for (int side = 0; side < 2; ++side) {
-        const double limit = side == 0 ? cam.nearZ : cam.farZ;
-        double s, tolValue;
-        if (cam.orthographic) {
-            s = side == 0 ? pv - limit : limit - pv;
-            tolValue = dErr + kFloatU * limit;
-        } else {
-            s = side == 0 ? 1 / limit - pv : pv - 1 / limit;
-            tolValue = (dErr + kFloatU * limit) / (limit * limit);  // d(1/d) = dd / d^2
-        }
-        if (gp > 0) take(s / gp, kSnapEdgeTolerancePx + tolValue / gp);
-        else take(s >= 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity(),
-                  kSnapEdgeTolerancePx);
-    }
+    nearFarConstraints(v, e, cam, r, px, py, q, take);
     out.signedPx = minS;
     out.tolerancePx = minTol;
     out.nearEdge = allAbove && anyWithin;
@@ -585,6 +611,47 @@ EdgeDistance EdgeDistanceMemo::operator()(uint32_t t, double px, double py) {
         rayPx_ = px, rayPy_ = py;
     }
     return edgeDistance(tri_[k], terms_[size_t(k)], cam_, *rays_, px, py);
+}
+
+bool EdgeDistanceMemo::nearEdge(uint32_t t, double px, double py) {
+    const int k = slot(t);
+    const EdgeTerms &e = terms_[size_t(k)];
+    if (!e.fast) return (*this)(t, px, py).nearEdge;
+    if (px != onePx_ || py != onePy_) {
+        ray_ = viewRayThroughPixel(cam_, px, py);  // operator()'s r, the same bits
+        rayLength_ = length(ray_.direction);
+        onePx_ = px, onePy_ = py;
+    }
+    // operator() takes, per edge, s = sigma f / g' with f = C . D(p) (these very operations, so
+    // the same f) and g' = |(f(p + x) - f(p), f(p + y) - f(p))| from two more rays, against the
+    // tolerance kSnap + E |D| / g'. Exactly, f is affine with gradient (fa, fb), so g' differs from
+    // g = |(fa, fb)| only by rounding: each f is a three-term dot product of computed ray
+    // components, within 64 u (mA px + mB py + mC) of its exact value (u = 2^-53; some 10 u
+    // would do), so |g' - g| <= eG = 3 * 64 u (M + mA + mB) + 8 u g with M = mA px + mB py + mC
+    // (the neighbours' M is at most M + mA + mB). With eG < g / 4, s' = sigma f / g' is within
+    // |s| (4/3) eG / g + 2 u |s| of s = sigma f / g, and the tolerance is at most kSnap +
+    // E |D| / g (1 + 2 eG / g + 8 u). An edge whose s exceeds that tolerance by 4 |s| eG / g +
+    // 4 u |s| has s' > its tolerance in operator() too: neither below -tolerance nor within it.
+    constexpr double u = 0x1p-53;
+    const double sigma = e.sigma;
+    for (int j = 0; j < 3; ++j) {
+        const double f = dot(e.C[j], ray_.direction);
+        const double g = e.g[j];
+        const double M = e.mA[j] * px + e.mB[j] * py + e.mC[j];
+        const double eG = 3 * 64 * u * (M + e.mA[j] + e.mB[j]) + 8 * u * g;
+        if (!(eG < g / 4)) return (*this)(t, px, py).nearEdge;
+        const double s = sigma * f / g;
+        const double slack = 4 * std::fabs(s) * eG / g + 4 * u * std::fabs(s);
+        const double tolUp = kSnapEdgeTolerancePx + e.E[j] * rayLength_ / g * (1 + 2 * eG / g + 8 * u);
+        if (!(s - slack > tolUp)) return (*this)(t, px, py).nearEdge;
+    }
+    // Every edge's constraint is above its tolerance: the answer is the near and far planes'.
+    bool allAbove = true, anyWithin = false;
+    nearFarConstraints(tri_[k], e, cam_, ray_, px, py, e.q, [&](double s, double tol) {
+        if (s < -tol) allAbove = false;
+        if (s <= tol) anyWithin = true;
+    });
+    return allAbove && anyWithin;
 }
 
 Disagreement classifyDisagreement(const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin,

@@ -157,7 +157,7 @@ PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisib
         }
         // Within the coverage uncertainty of either triangle's boundary (the float frame of the
         // edge bound at the eye: the rasterizer's snapping dominates).
-        const bool edge = (a && edgeAt(a - 1, px, py).nearEdge) || (b && edgeAt(b - 1, px, py).nearEdge);
+        const bool edge = (a && edgeAt.nearEdge(a - 1, px, py)) || (b && edgeAt.nearEdge(b - 1, px, py));
         classify(p, edge ? kOrderEdge : kOrderWrong);
         (edge ? c.edgePixels : c.wrongPixels)++;
     }
