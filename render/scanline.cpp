@@ -39,7 +39,15 @@ __attribute__((target("avx2"))) int64_t resolveSpanAvx2(const int32_t *cover, ui
     uint64_t w = 0, e = 0;
     for (; x + 3 <= x1; x += 4, xd = _mm256_add_pd(xd, four)) {
         const __m128i cov = _mm_loadu_si128(reinterpret_cast<const __m128i *>(cover + x));
-        const __m256d alone = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_cmpeq_epi32(cov, ones)));
+        const __m128i alone32 = _mm_cmpeq_epi32(cov, ones);
+        if (_mm_movemask_ps(_mm_castsi128_ps(alone32)) == 0xF) {
+            // The span alone holds all four centers (most of a row): they take its id, and no
+            // depth is computed or stored (as the blends below would do for them).
+            _mm_storeu_si128(reinterpret_cast<__m128i *>(rowId + x), _mm_set1_epi32(int32_t(id)));
+            w += 4;
+            continue;
+        }
+        const __m256d alone = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(alone32));
         const __m256d v = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(va, _mm256_add_pd(xd, half)), vb), vc);
         const __m256d d = orthographic ? v : _mm256_div_pd(one, v);
         const __m256d old = _mm256_loadu_pd(rowD + x);
@@ -61,6 +69,21 @@ __attribute__((target("avx2"))) int64_t resolveSpanAvx2(const int32_t *cover, ui
     writes += w;
     evaluations += e;
     return x;
+}
+// c[0..n) replaced by its prefix sums, four at a time (SSE2: two shifted adds within the
+// register, then the carry of the sums before it), the same integers as the running sum.
+void prefixSums(int32_t *c, size_t n) {
+    __m128i carry = _mm_setzero_si128();
+    size_t x = 0;
+    for (; x + 4 <= n; x += 4) {
+        __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i *>(c + x));
+        v = _mm_add_epi32(v, _mm_slli_si128(v, 4));
+        v = _mm_add_epi32(v, _mm_slli_si128(v, 8));
+        v = _mm_add_epi32(v, carry);
+        _mm_storeu_si128(reinterpret_cast<__m128i *>(c + x), v);
+        carry = _mm_shuffle_epi32(v, _MM_SHUFFLE(3, 3, 3, 3));
+    }
+    for (int32_t run = x ? c[x - 1] : 0; x < n; ++x) c[x] = run += c[x];
 }
 }  // namespace
 
@@ -172,7 +195,7 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
             --cover[size_t(s.x1) + 1];
             r.fragments += uint64_t(s.x1 - s.x0 + 1);
         }
-        for (int64_t x = 1; x < W; ++x) cover[size_t(x)] += cover[size_t(x) - 1];
+        prefixSums(cover.data(), size_t(W));
         std::fill(rowId.begin(), rowId.end(), 0);
         std::fill(rowD.begin(), rowD.end(), std::numeric_limits<double>::infinity());
         const double py = double(y) + 0.5;
@@ -202,9 +225,12 @@ ScanlineResult scanlineVisibility(const ScreenTriangles &tris, int width, int he
                 }
             }
         }
+        // Copied out and counted while the row is in cache (a row without spans stays 0).
+        uint64_t covered = 0;
+        for (int64_t x = 0; x < W; ++x) covered += rowId[size_t(x)] != 0;
+        r.coveredPixels += covered;
         std::copy(rowId.begin(), rowId.end(), r.id.begin() + y * W);
     }
-    for (uint32_t id : r.id) r.coveredPixels += id != 0;
     r.overdraw = r.coveredPixels ? double(r.writes) / double(r.coveredPixels) : 0;
     r.maxActiveTriangles = uint32_t(maxActive);
     r.maxSpansPerRow = uint32_t(maxSpans);
