@@ -418,6 +418,7 @@ struct LevelParts {
     size_t views = 0;
     uint64_t triangles = 0;
     int width = 0, height = 0;
+    bool orderingRan = false;  // in some view
 };
 bool readLevelParts(const fs::path &p, LevelParts *t, std::string *err) {
     nlohmann::json j;
@@ -438,7 +439,10 @@ bool readLevelParts(const fs::path &p, LevelParts *t, std::string *err) {
             const std::string name = s.value("name", "");
             (name == "raycast" ? t->raycast : t->pipeline) += num(s, "ms");
         }
-        if (v.contains("ordering")) t->ordering += num(v["ordering"], "ms");
+        if (v.contains("ordering")) {
+            t->ordering += num(v["ordering"], "ms");
+            t->orderingRan = t->orderingRan || v["ordering"].value("ran", false);
+        }
         if (v.contains("depth")) t->zfight += num(v["depth"], "ms");
         if (v.contains("detail")) t->detail += num(v["detail"], "ms");
         if (v.contains("audit")) t->referenceAndCross += num(v["audit"], "ms");
@@ -475,6 +479,9 @@ struct Bench {
     int sectionLoad();
     int sectionAnalyze();
     int sectionScaling();
+    // The per-part rows of an analyze run's report (issue 18's table): each audit's share of the
+    // views' CPU time, the output phase's of the run's, with their floors.
+    void partRows(const LevelParts &L);
 };
 
 // The "llvmpipe" section of the table (README, "Benchmarks": what it measures).
@@ -622,6 +629,33 @@ int Bench::sectionPipeline() {
     return 0;
 }
 
+// The per-part rows (README, "Benchmarks"): a part of the views, its share of the views' time; the
+// output phase, of the run's CPU time (views + output).
+void Bench::partRows(const LevelParts &L) {
+    const double cpu = L.viewsTotal + L.images + L.reportHtml;
+    auto part = [&](const char *name, double ms, const std::string &floor, bool pass, bool ofRun = false) {
+        table.add({name, fmt("%.1f CPU s", ms / 1e3), "",
+                   fmt("%.0f%% of the %s", 100 * ms / (ofRun ? cpu : L.viewsTotal), ofRun ? "run" : "views"),
+                   floor, floor.empty() ? "" : verdict(pass)});
+    };
+    if (L.orderingRan)
+        part("ordering audit (painter's, BSP, scanline, overdraw by order)", L.ordering, "<= 20% of a view's time",
+             L.ordering <= 0.2 * L.viewsTotal);
+    else
+        table.add({"ordering audit", "not run (report.json: views[].ordering.reason)", "", "", "", ""});
+    part("images (output.images_ms) + report + HTML", L.images + L.reportHtml, "<= 15% of the run",
+         L.images + L.reportHtml <= 0.15 * cpu, true);
+    part("z-fighting in every format (depth.ms)", L.zfight, "<= 10% of a view's time",
+         L.zfight <= 0.1 * L.viewsTotal);
+    part("raycast stage", L.raycast, "", true);
+    part("reference visibility audit + cross-check", L.referenceAndCross, "", true);
+    part("the game's pipeline: cells, frustum, occlusion, backface, clip, z-buffer", L.pipeline, "", true);
+    part("detail audit", L.detail, "", true);
+    part("rest of the views' time (bookkeeping, freeing)",
+         L.viewsTotal - L.ordering - L.zfight - L.raycast - L.referenceAndCross - L.pipeline - L.detail, "",
+         true);
+}
+
 // The "level" section of the table (README, "Benchmarks": what it measures).
 int Bench::sectionLevel() {
     const fs::path map = o.data / "openarena" / "pak6-patch088.pk3";
@@ -647,27 +681,7 @@ int Bench::sectionLevel() {
             table.add({"analyze, 2 threads: process wall time", fmt("%.1f s, peak %.0f MiB", c.wallS, c.peakMiB),
                        fmt("issue 18's baseline: %.0f s", kBaselineS), fmt("%.2fx faster", kBaselineS / c.wallS),
                        ">= 5x faster", verdict(kBaselineS / c.wallS >= 5)});
-            // A part of the views: its share of the views' time; the output phase: of the run's
-            // CPU time (views + output).
-            const double cpu = L.viewsTotal + L.images + L.reportHtml;
-            auto part = [&](const char *name, double ms, const std::string &floor, bool pass, bool ofRun = false) {
-                table.add({name, fmt("%.1f CPU s", ms / 1e3), "",
-                           fmt("%.0f%% of the %s", 100 * ms / (ofRun ? cpu : L.viewsTotal), ofRun ? "run" : "views"),
-                           floor, floor.empty() ? "" : verdict(pass)});
-            };
-            part("ordering audit (painter's, BSP, scanline, overdraw by order)", L.ordering,
-                 "<= 20% of a view's time", L.ordering <= 0.2 * L.viewsTotal);
-            part("images (output.images_ms) + report + HTML", L.images + L.reportHtml, "<= 15% of the run",
-                 L.images + L.reportHtml <= 0.15 * cpu, true);
-            part("z-fighting in every format (depth.ms)", L.zfight, "<= 10% of a view's time",
-                 L.zfight <= 0.1 * L.viewsTotal);
-            part("raycast stage", L.raycast, "", true);
-            part("reference visibility audit + cross-check", L.referenceAndCross, "", true);
-            part("the game's pipeline: cells, frustum, occlusion, backface, clip, z-buffer", L.pipeline, "", true);
-            part("detail audit", L.detail, "", true);
-            part("rest of the views' time (bookkeeping, freeing)",
-                 L.viewsTotal - L.ordering - L.zfight - L.raycast - L.referenceAndCross - L.pipeline - L.detail, "",
-                 true);
+            partRows(L);
             table.notes.push_back(fmt("level: shares are of the CPU time summed over views (views' total_ms %.1f s) "
                                       "plus the output phase; once per scene: load %.0f ms, ray scene %.0f ms, "
                                       "BSP tree %.0f ms", L.viewsTotal / 1e3, L.load, L.raySceneBuild, L.bspBuild));
@@ -738,6 +752,9 @@ int Bench::sectionAnalyze() {
                                       rt.imagesMs, rt.reportMs, rt.htmlMs,
                                       1e3 * c.wallS - rt.loadMs - rt.raySceneMs - rt.bspMs - rt.viewsTotalMs -
                                           rt.outputMs()));
+            // Issue 18's per-part table for these views too (the level section's rows).
+            LevelParts L;
+            if (readLevelParts(out / "report.json", &L, &err)) partRows(L);
         } else {
             table.add({fmt("analyze, all threads (%u): process wall time", cores),
                        fmt("%.2f s, peak %.0f MiB", c.wallS, c.peakMiB),
