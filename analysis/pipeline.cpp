@@ -193,10 +193,16 @@ void runCullingAudit(ViewContext &c, const TriangleLists &lists, std::vector<uin
         return;
     }
     const Stopwatch t0;
-    // The ordering audit walks the reference's fragments again in other orders: kept for it,
-    // up to 4 per pixel (48 bytes a pixel; estimateMemory), above which it rasterizes again.
+    // The ordering audit walks the reference's fragments again in other orders, and the z-fighting
+    // pass reads those of the triangles the z-buffer drew: kept for them, up to 4 per pixel (48
+    // bytes a pixel; estimateMemory), above which they rasterize again. Without the ordering audit
+    // (a scene over --ordering-max-triangles) the z-fighting pass alone is worth it: on the
+    // benchmark scene's orbit views (1M triangles, 1080p) its time fell from 196-208 to 93 ms for
+    // eight views, the reference's from 421-581 to 374-377, and the peak memory by 24 MB (a
+    // band of the two nearest surfaces instead of a whole view's).
     const uint64_t pixels = uint64_t(std::max(c.cam.width, 0)) * uint64_t(std::max(c.cam.height, 0));
-    const uint64_t cache = c.ps.hasBspTree() ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
+    const uint64_t cache =
+        c.ps.hasBspTree() || c.s.zfight ? std::min<uint64_t>(kOrderingCachedFragmentsPerPixel * pixels, 1ull << 31) : 0;
     r.audit = CullingAuditResult{};
     CullingAuditResult &a = *r.audit;
     a.reference = referenceVisibility(c.scene, c.cam, cache);
@@ -417,9 +423,11 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     //   reference id, depth; culling fate                  4 + 8 + 1 = 13
     //   raycast id, depth (+ u, v with effects); disagreements   8 (+ 8) + 1
     //   z-fighting: class, fight mask, hotspot ids (+ 2 nearest depths and triangles while it runs:
-    //     a band of them from the reference's fragments, the whole view without)
+    //     a band of them from the reference's fragments, the whole view without the audit)
     //     + the two-surface pixels' lists its thread keeps (pixel, two depths, two triangles, fight
-    //     mask, two depth cells, an index: at most one entry per pixel)   9 + 24 + 44
+    //     mask, two depth cells, an index: at most one entry per pixel)   9 (+ 24) + 44
+    //   the reference's fragment cache, for the z-fighting pass and the ordering audit
+    //     (12 bytes a fragment)                            12 * kOrderingCachedFragmentsPerPixel
     //   ordering: painter and BSP id + class, scanline id, per-order overdraw, A-buffer composite,
     //     edges, heads, lengths and center depth          5 + 5 + 4 + 8 + 4 + 24
     //   occlusion's pre-pass depth and Hi-Z pyramid (freed before the z-buffer)   not added
@@ -427,13 +435,16 @@ MemoryEstimate estimateMemory(const Scene &scene, const std::vector<Camera> &cam
     uint64_t perPixel = 20 + 16;
     if (s.audit) perPixel += 13;
     if (s.raycast) perPixel += 17;  // + the cross-check's recast over the z-buffer's set (id, depth)
-    if (s.zfight) perPixel += 33 + 44;
+    const bool ordering = s.ordering && s.audit && tris <= s.orderingMaxTriangles;
+    const bool cached = s.audit && (s.zfight || ordering);  // runCullingAudit
+    if (cached) perPixel += 12 * kOrderingCachedFragmentsPerPixel;
+    if (s.zfight) perPixel += 9 + (s.audit ? 0 : 24) + 44;
     const EffectPlan plan = planEffects(scene, s.effects);
     if (s.raycast && plan.tracesRays()) perPixel += 8 + 3 + (scene.lights.size() + 7) / 8;
-    if (s.ordering && s.audit && tris <= s.orderingMaxTriangles) {
-        // + the reference's fragment cache (12 bytes a fragment), and the ordering's per-thread
-        // scratch: a depth buffer (8) and the BSP's piece lists and owners (4 bytes a fragment, 3x).
-        perPixel += 22 + 12 * kOrderingCachedFragmentsPerPixel + 8 + 12 * kOrderingCachedFragmentsPerPixel;
+    if (ordering) {
+        // + the ordering's per-thread scratch: a depth buffer (8) and the BSP's piece lists and
+        // owners (4 bytes a fragment, 3x).
+        perPixel += 22 + 8 + 12 * kOrderingCachedFragmentsPerPixel;
         // The A-buffer's fragments: a level's depth complexity is a few layers; the pool itself is
         // counted before it is allocated (--max-abuffer-list), 20 bytes a fragment.
         if (plan.abuffer.run) perPixel += 36 + 4 * sizeof(ABufferFragment);
