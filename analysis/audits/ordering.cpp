@@ -545,7 +545,16 @@ struct BandedDraw {
                 }
             }
         };
-        for (uint32_t i = bandBegin[b]; i < bandBegin[b + 1]; ++i) {
+        const uint32_t end = bandBegin[b + 1];
+        for (uint32_t i = bandBegin[b]; i < end; ++i) {
+            // A band's runs jump about the cache (each a short stretch of one triangle's
+            // fragments): the one two ahead has its first fragments' lines fetched meanwhile.
+            if (i + 2 < end) {
+                const uint64_t at = runs[bandRuns[i + 2]].at;
+                __builtin_prefetch(pixelOf + at);
+                __builtin_prefetch(depthOf + at);
+                __builtin_prefetch(depthOf + at + 8);
+            }
             DrawRun &run = runs[bandRuns[i]];
             uint64_t f = run.at;
             const uint64_t f0 = f;
