@@ -702,12 +702,10 @@ EdgeDistance edgeDistanceFromScratch(const ViewTriangle &v, const Camera &cam, d
     return out;
 }
 
-// The memo (per-triangle terms kept, a pixel's rays shared by the triangles asked there) and the
-// plain call give edgeDistanceFromScratch's values bit for bit: random triangles, some reaching
-// behind the eye, some edge-on, both projections, the memo asked in runs along rows, alternating
-// between two triangles at a pixel and switching among more than it keeps.
-TEST(AuditEdgeDistance, MemoEqualsFromScratchBitForBit) {
-    std::mt19937 rng(11);
+// Random triangles a few units in front of the eye of edgeTestCamera, some reaching behind it
+// (every fifth), some edge-on (every seventh: no area).
+std::vector<std::array<Vec3, 3>> edgeTestTriangles(unsigned seed) {
+    std::mt19937 rng(seed);
     std::uniform_real_distribution<double> U(-4, 4);
     std::vector<std::array<Vec3, 3>> tris;
     for (int i = 0; i < 40; ++i) {
@@ -717,17 +715,30 @@ TEST(AuditEdgeDistance, MemoEqualsFromScratchBitForBit) {
         if (i % 7 == 0) t[2] = t[0] + (t[1] - t[0]) * 0.5;  // degenerate: no area
         tris.push_back(t);
     }
+    return tris;
+}
+// A 64 x 48 camera at (0.3, -0.2, 1) looking at (0, 0, -6), near 0.1, far 1000.
+void edgeTestCamera(bool orthographic, CameraSpec &cs, Camera &cam) {
+    cs.eye = {0.3, -0.2, 1};
+    cs.target = {0, 0, -6};
+    cs.orthographic = orthographic;
+    cs.width = 64;
+    cs.height = 48;
+    std::string err;
+    ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+}
+
+// The memo (per-triangle terms kept, a pixel's rays shared by the triangles asked there) and the
+// plain call give edgeDistanceFromScratch's values bit for bit: random triangles, some reaching
+// behind the eye, some edge-on, both projections, the memo asked in runs along rows, alternating
+// between two triangles at a pixel and switching among more than it keeps.
+TEST(AuditEdgeDistance, MemoEqualsFromScratchBitForBit) {
+    const std::vector<std::array<Vec3, 3>> tris = edgeTestTriangles(11);
     const Scene scene = testing_util::looseTriangles(tris, true);
     for (bool ortho : {false, true}) {
         CameraSpec cs;
-        cs.eye = {0.3, -0.2, 1};
-        cs.target = {0, 0, -6};
-        cs.orthographic = ortho;
-        cs.width = 64;
-        cs.height = 48;
         Camera cam;
-        std::string err;
-        ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+        ASSERT_NO_FATAL_FAILURE(edgeTestCamera(ortho, cs, cam));
         const Vec3 origin{0.5, 0.25, -2};
         EdgeDistanceMemo memo(scene, cam, origin);
         uint64_t compared = 0, near = 0;
@@ -765,16 +776,7 @@ TEST(AuditEdgeDistance, MemoEqualsFromScratchBitForBit) {
 // bounds of its shortcut must leave the answer to operator(). Mutations: dropping the slack or the
 // tolerance's factor, or answering false once the edges pass, fail it.
 TEST(AuditEdgeDistance, NearEdgeShortcutGivesTheFullAnswer) {
-    std::mt19937 rng(23);
-    std::uniform_real_distribution<double> U(-4, 4);
-    std::vector<std::array<Vec3, 3>> tris;
-    for (int i = 0; i < 40; ++i) {
-        const Vec3 c{U(rng), U(rng), U(rng) - 6};
-        std::array<Vec3, 3> t;
-        for (auto &p : t) p = c + Vec3{U(rng), U(rng), U(rng) * (i % 5 == 0 ? 3 : 0.5)};
-        if (i % 7 == 0) t[2] = t[0] + (t[1] - t[0]) * 0.5;  // degenerate: no area
-        tris.push_back(t);
-    }
+    std::vector<std::array<Vec3, 3>> tris = edgeTestTriangles(23);
     // Four cut by the near plane (0.1 in front of the eye at z = 1) and four by the far one (1000).
     for (int i = 0; i < 4; ++i) {
         const double a = 0.4 * i;
@@ -784,14 +786,8 @@ TEST(AuditEdgeDistance, NearEdgeShortcutGivesTheFullAnswer) {
     const Scene scene = testing_util::looseTriangles(tris, true);
     for (bool ortho : {false, true}) {
         CameraSpec cs;
-        cs.eye = {0.3, -0.2, 1};
-        cs.target = {0, 0, -6};
-        cs.orthographic = ortho;
-        cs.width = 64;
-        cs.height = 48;
         Camera cam;
-        std::string err;
-        ASSERT_TRUE(makeCamera(cs, &cam, &err)) << err;
+        ASSERT_NO_FATAL_FAILURE(edgeTestCamera(ortho, cs, cam));
         const Vec3 origin{0.5, 0.25, -2};
         EdgeDistanceMemo shortcut(scene, cam, origin), full(scene, cam, origin);
         uint64_t inside = 0, near = 0, flips = 0;
