@@ -998,6 +998,30 @@ void bspCompare(const OrderingView &v, const ReferenceVisibility &ref, BspViewRe
 
 }  // namespace
 
+BspFragmentOwners bspFragmentOwners(const OrderingView &v, const BspTree &tree) {
+    BspFragmentOwners o;
+    if (!v.fragments) return o;
+    const FragmentCache &fc = *v.fragments;
+    std::vector<DrawItem> items;
+    BspViewResult r;
+    const BspViewPlanes planes = bspItems(v, tree, items, r);
+    ItemFragments sel;
+    selectFragments(v, items, &tree, &planes, sel);
+    o.selected.assign(fc.pixel.size(), UINT32_MAX);
+    o.direct.assign(fc.pixel.size(), UINT32_MAX);
+    const PixelRays rays(v.cam);
+    for (size_t k = 0; k < items.size(); ++k) {
+        if (!sel.listed[k]) continue;
+        for (uint64_t i = sel.begin[k]; i < sel.begin[k + 1]; ++i)
+            for (uint64_t f = sel.range[i].at; f < sel.range[i].end; ++f) o.selected[f] = uint32_t(k);
+        const uint32_t s = items[k].source;
+        for (uint64_t f = fc.begin[v.screenBegin[s]]; f < fc.begin[v.screenEnd[s]]; ++f)
+            if (bspPieceContains(tree, planes, items[k].piece, rays.point(fc.pixel[f], fc.depth[f])))
+                o.direct[f] = uint32_t(k);
+    }
+    return o;
+}
+
 BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree) {
     BspViewResult r;
     std::vector<DrawItem> items;

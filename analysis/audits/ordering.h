@@ -189,6 +189,14 @@ struct BspViewResult {
     UninitVector<uint32_t> id;        // per pixel, 1 + source, back to front without depth test
 };
 BspViewResult bspForView(const OrderingView &v, const ReferenceVisibility &ref, const BspTree &tree);
+// For tests, on a view with the fragment cache: per cached fragment, the BSP draw item (a piece of
+// a split source) that the draws' selection gives it (`selected`), and the one whose constraints
+// hold at its surface point tested fragment by fragment (bspPieceContains: `direct`); UINT32_MAX
+// where no piece of a split source holds it, and for the fragments of sources that are not split.
+struct BspFragmentOwners {
+    std::vector<uint32_t> selected, direct;
+};
+BspFragmentOwners bspFragmentOwners(const OrderingView &v, const BspTree &tree);
 
 // ---- The ordering table -------------------------------------------------------------------------
 
