@@ -439,7 +439,7 @@ struct EdgeTerms {
     RayDepthTerms depth;  // perspective
     // Perspective, for EdgeDistanceMemo::nearEdge: edge k's f(p) = C . D(p) is affine in the pixel,
     // f = fa px + fb py + f0 exactly, so its gradient is (fa, fb) and g = |(fa, fb)| (the value the
-    // three rays' differences approximate); |Cx| |Dx(p)| + |Cy| |Dy(p)| + |Cz| <= mA px + mB py + mC
+    // three rays' differences approximate); |Cx| |Dx(p)| + |Cy| |Dy(p)| + |Cz| <= mA |px| + mB |py| + mC
     // bounds the terms of f's dot product (its rounding). fast: these are usable (finite, g > 0).
     double g[3] = {}, mA[3] = {}, mB[3] = {}, mC[3] = {};
     bool fast = false;
@@ -626,8 +626,8 @@ bool EdgeDistanceMemo::nearEdge(uint32_t t, double px, double py) {
     // the same f) and g' = |(f(p + x) - f(p), f(p + y) - f(p))| from two more rays, against the
     // tolerance kSnap + E |D| / g'. Exactly, f is affine with gradient (fa, fb), so g' differs from
     // g = |(fa, fb)| only by rounding: each f is a three-term dot product of computed ray
-    // components, within 64 u (mA px + mB py + mC) of its exact value (u = 2^-53; some 10 u
-    // would do), so |g' - g| <= eG = 3 * 64 u (M + mA + mB) + 8 u g with M = mA px + mB py + mC
+    // components, within 64 u (mA |px| + mB |py| + mC) of its exact value (u = 2^-53; some 10 u
+    // would do), so |g' - g| <= eG = 3 * 64 u (M + mA + mB) + 8 u g with M = mA |px| + mB |py| + mC
     // (the neighbours' M is at most M + mA + mB). With eG < g / 4, s' = sigma f / g' is within
     // |s| (4/3) eG / g + 2 u |s| of s = sigma f / g, and the tolerance is at most kSnap +
     // E |D| / g (1 + 2 eG / g + 8 u). An edge whose s exceeds that tolerance by 4 |s| eG / g +
@@ -637,7 +637,7 @@ bool EdgeDistanceMemo::nearEdge(uint32_t t, double px, double py) {
     for (int j = 0; j < 3; ++j) {
         const double f = dot(e.C[j], ray_.direction);
         const double g = e.g[j];
-        const double M = e.mA[j] * px + e.mB[j] * py + e.mC[j];
+        const double M = e.mA[j] * std::fabs(px) + e.mB[j] * std::fabs(py) + e.mC[j];
         const double eG = 3 * 64 * u * (M + e.mA[j] + e.mB[j]) + 8 * u * g;
         if (!(eG < g / 4)) return (*this)(t, px, py).nearEdge;
         const double s = sigma * f / g;
