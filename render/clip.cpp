@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 
 #include "render/clip_vertices.h"
 #include "render/large_pages.h"
@@ -90,12 +92,16 @@ int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, Cli
 // Appends a valid plane field by field. (push_back(plane) copied the struct through the stack in
 // two 16-byte halves, the second spanning the 8-byte store of c and the 1-byte store of valid: a
 // failed store-to-load forward on every accepted triangle, about a quarter of the stage's time.)
-[[gnu::always_inline]] inline void appendPlane(std::vector<DepthPlane> &planes, const DepthPlane &p) {
-    DepthPlane &d = planes.emplace_back();
+[[gnu::always_inline]] inline void appendPlane(RawVector<DepthPlane> &planes, const DepthPlane &p) {
+    DepthPlane &d = planes.emplace_back();  // unwritten (raw_vector.h): every byte is stored below
     d.a = p.a;
     d.b = p.b;
     d.c = p.c;
-    d.valid = true;
+    // valid = true and the padding after it zero, as one 8-byte word (clip_avx2.cpp's staged rows
+    // write the same word).
+    static_assert(sizeof(DepthPlane) == 32 && offsetof(DepthPlane, valid) == 24, "DepthPlane's layout");
+    const uint64_t validWord = 1;
+    std::memcpy(reinterpret_cast<unsigned char *>(&d) + 24, &validWord, 8);
 }
 
 // One triangle through the stage: trivial reject, depth plane, accept or Sutherland-Hodgman, fan

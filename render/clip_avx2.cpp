@@ -96,25 +96,6 @@ void transform4(const VertexPassParams &p, const Vec3 *pos, uint32_t n, BatchVer
     transformVerticesBody<kOrtho>(p, pos, n4, n, bv);  // the last n % 4
 }
 
-// The staged output of up to kStage accepted triangles, appended to the ScreenTriangles at once
-// (a vector's size cannot grow without writing its new elements: one insert per array per stage).
-constexpr uint32_t kStage = 64;
-struct Stage {
-    alignas(32) DepthPlane planes[kStage];
-    alignas(32) int32_t xy[6 * kStage];
-    alignas(32) uint32_t source[kStage], plane[kStage];
-    uint32_t n = 0;
-
-    void flush(ScreenTriangles &out) {
-        if (n == 0) return;
-        out.planes.insert(out.planes.end(), planes, planes + n);
-        out.xy.insert(out.xy.end(), xy, xy + 6 * n);
-        out.source.insert(out.source.end(), source, source + n);
-        out.plane.insert(out.plane.end(), plane, plane + n);
-        n = 0;
-    }
-};
-
 inline __m256d isFinite4(__m256d v) {
     const __m256d absMask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7FFFFFFFFFFFFFFF));
     return _mm256_cmp_pd(_mm256_and_pd(v, absMask), _mm256_set1_pd(INFINITY), _CMP_LT_OQ);
@@ -133,12 +114,22 @@ uint32_t acceptGroupsAvx2(const DepthPlaneMaker &p, const BatchVertices &bv, con
     const uint32_t *code = bv.code.data();
     const int32_t *sxy = bv.sxy.data();
     const uint32_t *tri = batch.triangles;
-    // The fourth double of each staged plane: the bytes of `valid = true` and zero padding.
+    // The fourth double of each plane row: the bytes of `valid = true` and zero padding.
     const __m256d validWord = _mm256_castsi256_pd(_mm256_set1_epi64x(1));
     static_assert(sizeof(DepthPlane) == 32 && offsetof(DepthPlane, valid) == 24, "DepthPlane's layout");
 
-    Stage stage;
+    // Room for every group left in the batch, written in place (ScreenTriangles' vectors add
+    // elements unwritten: render/raw_vector.h) and cut back to what was taken at the end.
     const uint32_t begin = k, vb = batch.vertexBegin;
+    const size_t room = (batch.count - k) & ~size_t(3);
+    const size_t t0 = out.source.size(), p0 = out.planes.size();
+    out.planes.resize(p0 + room);
+    out.xy.resize(6 * (t0 + room));
+    out.source.resize(t0 + room);
+    out.plane.resize(t0 + room);
+    DepthPlane *planesOut = out.planes.data() + p0;
+    int32_t *xyOut = out.xy.data() + 6 * t0;
+    uint32_t *sourceOut = out.source.data() + t0, *planeOut = out.plane.data() + t0;
     uint64_t inside = 0;
     for (; k + 4 <= batch.count; k += 4) {
         if (k + 20 <= batch.count)
@@ -188,31 +179,33 @@ uint32_t acceptGroupsAvx2(const DepthPlaneMaker &p, const BatchVertices &bv, con
         if (_mm256_movemask_pd(ok) != 0xF) break;
 
         // Taken: the planes as four rows (a, b, c, valid), the corners, sources and plane indices.
-        if (stage.n + 4 > kStage) stage.flush(out);
+        const size_t j0 = k - begin;  // the group's first output slot
         // ab01 = a0 b0 | a2 b2, ab23 = a1 b1 | a3 b3; cv01, cv23 likewise: rows from their halves.
         const __m256d ab01 = _mm256_unpacklo_pd(a, b), ab23 = _mm256_unpackhi_pd(a, b);
         const __m256d cv01 = _mm256_unpacklo_pd(c, validWord), cv23 = _mm256_unpackhi_pd(c, validWord);
-        double *dst = reinterpret_cast<double *>(stage.planes + stage.n);
-        _mm256_store_pd(dst + 0, _mm256_permute2f128_pd(ab01, cv01, 0x20));
-        _mm256_store_pd(dst + 4, _mm256_permute2f128_pd(ab23, cv23, 0x20));
-        _mm256_store_pd(dst + 8, _mm256_permute2f128_pd(ab01, cv01, 0x31));
-        _mm256_store_pd(dst + 12, _mm256_permute2f128_pd(ab23, cv23, 0x31));
-        int32_t *xy = stage.xy + 6 * stage.n;
+        double *dst = reinterpret_cast<double *>(planesOut + j0);
+        _mm256_storeu_pd(dst + 0, _mm256_permute2f128_pd(ab01, cv01, 0x20));
+        _mm256_storeu_pd(dst + 4, _mm256_permute2f128_pd(ab23, cv23, 0x20));
+        _mm256_storeu_pd(dst + 8, _mm256_permute2f128_pd(ab01, cv01, 0x31));
+        _mm256_storeu_pd(dst + 12, _mm256_permute2f128_pd(ab23, cv23, 0x31));
+        int32_t *xy = xyOut + 6 * j0;
         for (int j = 0; j < 4; ++j) {
             std::memcpy(xy + 6 * j, sxy + 2 * size_t(i0[j]), 8);
             std::memcpy(xy + 6 * j + 2, sxy + 2 * size_t(i1[j]), 8);
             std::memcpy(xy + 6 * j + 4, sxy + 2 * size_t(i2[j]), 8);
         }
-        _mm_store_si128(reinterpret_cast<__m128i *>(stage.source + stage.n),
-                        _mm_loadu_si128(reinterpret_cast<const __m128i *>(tri + k)));
-        const int32_t pi = int32_t(out.planes.size() + stage.n);
-        _mm_store_si128(reinterpret_cast<__m128i *>(stage.plane + stage.n),
-                        _mm_add_epi32(_mm_set1_epi32(pi), _mm_setr_epi32(0, 1, 2, 3)));
-        stage.n += 4;
+        _mm_storeu_si128(reinterpret_cast<__m128i *>(sourceOut + j0),
+                         _mm_loadu_si128(reinterpret_cast<const __m128i *>(tri + k)));
+        const int32_t pi = int32_t(p0 + j0);
+        _mm_storeu_si128(reinterpret_cast<__m128i *>(planeOut + j0),
+                         _mm_add_epi32(_mm_set1_epi32(pi), _mm_setr_epi32(0, 1, 2, 3)));
         inside += insideHere;
     }
-    stage.flush(out);
     const uint32_t taken = k - begin;
+    out.planes.resize(p0 + taken);
+    out.xy.resize(6 * (t0 + taken));
+    out.source.resize(t0 + taken);
+    out.plane.resize(t0 + taken);
     counts.inside += inside;
     counts.guardBandAccepted += taken - inside;
     return taken;

@@ -16,8 +16,8 @@ namespace va {
 
 // Room for n elements in v (empty), its memory advised to be backed by huge pages before the
 // first touch: pages are faulted in only as elements arrive, 2 MiB at a time.
-template <class T>
-void reserveOnLargePages(std::vector<T> &v, size_t n) {
+template <class T, class A>
+void reserveOnLargePages(std::vector<T, A> &v, size_t n) {
     v.clear();
     v.reserve(n);  // allocates without touching the pages
 #ifdef MADV_HUGEPAGE
@@ -29,8 +29,8 @@ void reserveOnLargePages(std::vector<T> &v, size_t n) {
 }
 
 // v = n copies of x, its memory advised to be backed by huge pages before the first touch.
-template <class T>
-void assignOnLargePages(std::vector<T> &v, size_t n, T x) {
+template <class T, class A>
+void assignOnLargePages(std::vector<T, A> &v, size_t n, T x) {
     reserveOnLargePages(v, n);
     v.assign(n, x);
 }

@@ -16,6 +16,7 @@
 
 #include "render/camera.h"
 #include "render/depth_format.h"
+#include "render/raw_vector.h"
 
 namespace va {
 
@@ -24,10 +25,12 @@ constexpr int32_t kSubpixelOne = 1 << kSubpixelBits;
 
 // Screen-space triangles ready to rasterize (the clip stage's output), in submission order.
 struct ScreenTriangles {
-    std::vector<int32_t> xy;          // 6 per triangle: x0 y0 x1 y1 x2 y2, pixel units * 2^kSubpixelBits
-    std::vector<uint32_t> source;     // per triangle: the scene's global source triangle index
-    std::vector<uint32_t> plane;      // per triangle: index into planes (pieces of one source share one)
-    std::vector<DepthPlane> planes;   // depth planes, one per source triangle that produced output
+    // RawVector (raw_vector.h): resize adds elements unwritten, so the clipper resizes and writes
+    // accepted triangles in place.
+    RawVector<int32_t> xy;          // 6 per triangle: x0 y0 x1 y1 x2 y2, pixel units * 2^kSubpixelBits
+    RawVector<uint32_t> source;     // per triangle: the scene's global source triangle index
+    RawVector<uint32_t> plane;      // per triangle: index into planes (pieces of one source share one)
+    RawVector<DepthPlane> planes;   // depth planes, one per source triangle that produced output
 
     size_t size() const { return source.size(); }
     void clear() { xy.clear(); source.clear(); plane.clear(); planes.clear(); }
