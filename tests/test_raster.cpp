@@ -1044,27 +1044,38 @@ TEST(RasterOptions, FragmentsPerSource) {
 // pixel count that is not a multiple of four.
 TEST(ZBufferStats, HistogramEqualsAPlainCount) {
     std::mt19937 rng(5);
-    for (size_t pixels : {size_t(0), size_t(1), size_t(7), size_t(4099)}) {
-        ZBuffer zb;
-        zb.width = int(pixels), zb.height = 1;
-        zb.fragments.resize(pixels);
-        for (uint16_t &c : zb.fragments) {
-            const uint32_t r = rng() % 100;
-            c = r < 60   ? uint16_t(r % 4)
-                : r < 90 ? uint16_t(60 + rng() % 10)
-                : r < 99 ? uint16_t(rng() % 3000)
-                         : uint16_t(0xFFFF);
+    // Sizes around the AVX2 path's 16-pixel vectors and its 65,536-pixel blocks (finishZBufferStats'
+    // histogramAvx2); mixed counts, and counts below 8 only (every vector on the lane counters,
+    // which reach their most, 4096, in a block of one count) with a few larger ones in long runs.
+    for (int mode : {0, 1, 2}) {
+        for (size_t pixels : {size_t(0), size_t(1), size_t(7), size_t(4099), size_t(65536), size_t(200003)}) {
+            ZBuffer zb;
+            zb.width = int(pixels), zb.height = 1;
+            zb.fragments.resize(pixels);
+            for (size_t i = 0; i < pixels; ++i) {
+                uint16_t &c = zb.fragments[i];
+                const uint32_t r = rng() % 100;
+                if (mode == 0)
+                    c = r < 60   ? uint16_t(r % 4)
+                        : r < 90 ? uint16_t(60 + rng() % 10)
+                        : r < 99 ? uint16_t(rng() % 3000)
+                                 : uint16_t(0xFFFF);
+                else if (mode == 1)
+                    c = uint16_t(r % 8);
+                else
+                    c = i < 70000 ? uint16_t(5) : (i / 977) % 7 == 0 ? uint16_t(8 + r % 3) : uint16_t(r % 8);
+            }
+            std::vector<uint64_t> plain(65536, 0);
+            for (uint16_t c : zb.fragments) ++plain[c];
+            size_t top = 65535;
+            while (top > 0 && plain[top] == 0) --top;
+            plain.resize(top + 1);
+            ZBufferStats st;
+            finishZBufferStats(zb, &st);
+            EXPECT_EQ(st.histogram, plain) << "mode " << mode << ", " << pixels << " pixels";
+            EXPECT_EQ(st.coveredPixels, pixels - plain[0]);
+            EXPECT_EQ(st.maxDepthComplexity, uint32_t(top));
         }
-        std::vector<uint64_t> plain(65536, 0);
-        for (uint16_t c : zb.fragments) ++plain[c];
-        size_t top = 65535;
-        while (top > 0 && plain[top] == 0) --top;
-        plain.resize(top + 1);
-        ZBufferStats st;
-        finishZBufferStats(zb, &st);
-        EXPECT_EQ(st.histogram, plain) << pixels;
-        EXPECT_EQ(st.coveredPixels, pixels - plain[0]);
-        EXPECT_EQ(st.maxDepthComplexity, uint32_t(top));
     }
 }
 
