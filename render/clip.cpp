@@ -97,7 +97,7 @@ int clipPolygon(const ClipSpace &cs, int plane, const ClipVertex *in, int n, Cli
     d.a = p.a;
     d.b = p.b;
     d.c = p.c;
-    // valid = true and the padding after it zero, as one 8-byte word (clip_avx2.cpp's staged rows
+    // valid = true and the padding after it zero, as one 8-byte word (clip_avx2.cpp's plane rows
     // write the same word).
     static_assert(sizeof(DepthPlane) == 32 && offsetof(DepthPlane, valid) == 24, "DepthPlane's layout");
     const uint64_t validWord = 1;
