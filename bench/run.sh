@@ -6,6 +6,8 @@
 #   bash bench/run.sh                      # everything (the 10M x 64 views case alone takes minutes)
 #   bash bench/run.sh --quick              # 3 repetitions; scaling without 10M triangles and 64 views
 #   bash bench/run.sh --sections zbuffer,llvmpipe,raycast,pipeline,load,analyze,level,scaling [--reps N] [--keep]
+#   bash bench/run.sh --baseline ...       # the level section also runs issue 18's start (built once by
+#                                          # bench/issue18_baseline.sh) in the same run, for its 5x floor
 #
 # Builds visaudit and bench_table (Release) in $BUILD (default: build/), then runs
 # $BUILD/bench/bench_table; progress goes to stderr, the table to stdout. Floors are printed as
@@ -17,4 +19,12 @@ if [ ! -f "$BUILD/CMakeCache.txt" ]; then
   cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
 fi
 cmake --build "$BUILD" -j"$(nproc)" --target visaudit bench_table >&2
-exec "$BUILD/bench/bench_table" --visaudit "$BUILD/visaudit" --data "$ROOT/data" "$@"
+args=()
+for a in "$@"; do
+  if [ "$a" = "--baseline" ]; then
+    args+=(--baseline "$(BUILD="$BUILD" bash "$ROOT/bench/issue18_baseline.sh")")
+  else
+    args+=("$a")
+  fi
+done
+exec "$BUILD/bench/bench_table" --visaudit "$BUILD/visaudit" --data "$ROOT/data" "${args[@]}"
