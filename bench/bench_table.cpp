@@ -737,19 +737,20 @@ int Bench::sectionLevel() {
                            fmt("%.2fx faster", kBaselineS / c.wallS), ">= 5x faster", verdict(kBaselineS / c.wallS >= 5)});
             } else if (base.status != 0) {
                 table.add({"analyze, 2 threads: process wall time", value,
-                           fmt("issue 18's start (%s): failed, exit %d (see %s)", kBaselineCommit, base.status,
+                           fmt("--baseline: failed, exit %d (see %s)", base.status,
                                (o.work / "level-baseline.log").c_str()),
                            "", ">= 5x faster", ""});
             } else {
                 table.add({"analyze, 2 threads: process wall time", value,
-                           fmt("issue 18's start (%s), this run: %.1f s, peak %.0f MiB", kBaselineCommit, base.wallS,
-                               base.peakMiB),
+                           fmt("--baseline (issue 18's start, %s, from run.sh), this run: %.1f s, peak %.0f MiB",
+                               kBaselineCommit, base.wallS, base.peakMiB),
                            fmt("%.2fx faster", base.wallS / c.wallS), ">= 5x faster", verdict(base.wallS / c.wallS >= 5)});
             }
             partRows(L, haveBaseParts ? &baseParts : nullptr);
             table.notes.push_back(fmt("level: shares are of the CPU time summed over views (views' total_ms %.1f s) "
                                       "plus the output phase; once per scene: load %.0f ms, ray scene %.0f ms, "
                                       "BSP tree %.0f ms", L.viewsTotal / 1e3, L.load, L.raySceneBuild, L.bspBuild));
+            if (!o.baseline.empty()) table.notes.push_back("level: --baseline is " + o.baseline);
         }
         if (!o.keep) fs::remove_all(out);
     }
