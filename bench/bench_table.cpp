@@ -716,6 +716,7 @@ int Bench::sectionLevel() {
         ChildRun base, c;
         LevelParts baseParts, L;
         bool haveBaseParts = false, haveParts = false;
+        std::string baseWhy;  // why no baseline run could be read, when none could
         for (int rep = 0; rep < o.levelReps; ++rep) {
             if (!o.baseline.empty()) {
                 progress(fmt("level: the start's run %d of %d (--baseline; a few minutes)", rep + 1, o.levelReps));
@@ -723,11 +724,11 @@ int Bench::sectionLevel() {
                 fs::remove_all(baseOut);
                 const ChildRun b = runChild(analyzeArgs(o.baseline, baseOut), o.work / "level-baseline.log");
                 LevelParts parts;
-                std::string baseErr;
                 if (b.status != 0) {
+                    if (!haveBaseParts) base = b, baseWhy = fmt("exit %d", b.status);
+                } else if (!readLevelParts(baseOut / "report.json", &parts, &baseWhy)) {
                     if (!haveBaseParts) base = b;
-                } else if (readLevelParts(baseOut / "report.json", &parts, &baseErr) &&
-                           (!haveBaseParts || b.wallS < base.wallS)) {
+                } else if (!haveBaseParts || b.wallS < base.wallS) {
                     base = b, baseParts = parts, haveBaseParts = true;
                 }
                 if (!o.keep) fs::remove_all(baseOut);
@@ -756,7 +757,7 @@ int Bench::sectionLevel() {
                            fmt("%.2fx faster", kBaselineS / c.wallS), ">= 5x faster", verdict(kBaselineS / c.wallS >= 5)});
             } else if (!haveBaseParts) {
                 table.add({"analyze, 2 threads: process wall time", value,
-                           fmt("--baseline: failed, exit %d (see %s)", base.status,
+                           fmt("--baseline: failed, %s (see %s)", baseWhy.c_str(),
                                (o.work / "level-baseline.log").c_str()),
                            "", ">= 5x faster", ""});
             } else {
