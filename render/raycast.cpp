@@ -13,6 +13,7 @@
 #include <embree3/rtcore.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <immintrin.h>
 #endif
 #include <tbb/parallel_for.h>
 
@@ -321,6 +322,36 @@ void primaryFilter(const RTCFilterFunctionNArguments *args) {
         if (valid[i] == -1) lane(i);
 }
 
+// A packet whose 16 lanes are all valid, stored as castBand's lane loop stores it, a packet row of
+// four pixels at a time: id = 1 + source of the hit primitive (0 on a miss), depth = tfar (+inf on a
+// miss), and with kBary Embree's u, v (0 on a miss). `at` is the packet's top-left pixel in the
+// band's buffers of row length `w`. Returns the packet's hits. The lane loop spent a tenth of a
+// coherent cast's time here, a branch and a scattered store per lane.
+template <bool kBary>
+__attribute__((target("avx2"))) uint64_t storeWholePacketAvx2(const RTCRayHit16 &rh, const uint32_t *toSource, size_t at,
+                                                               size_t w, uint32_t *id, float *depth, float *u, float *v) {
+    const __m128i invalid = _mm_set1_epi32(int(RTC_INVALID_GEOMETRY_ID));
+    const __m128i one = _mm_set1_epi32(1), ones = _mm_set1_epi32(-1);
+    const __m128 inf = _mm_set1_ps(INFINITY);
+    int misses = 0;
+    for (int j = 0; j < kPacket; ++j) {
+        const size_t p = at + size_t(j) * w;
+        const __m128i miss = _mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i *>(rh.hit.geomID + 4 * j)), invalid);
+        const __m128 missF = _mm_castsi128_ps(miss);
+        const __m128i prim = _mm_loadu_si128(reinterpret_cast<const __m128i *>(rh.hit.primID + 4 * j));
+        const __m128i src = _mm_mask_i32gather_epi32(_mm_setzero_si128(), reinterpret_cast<const int *>(toSource), prim,
+                                                     _mm_xor_si128(miss, ones), 4);
+        _mm_storeu_si128(reinterpret_cast<__m128i *>(id + p), _mm_andnot_si128(miss, _mm_add_epi32(src, one)));
+        _mm_storeu_ps(depth + p, _mm_blendv_ps(_mm_loadu_ps(rh.ray.tfar + 4 * j), inf, missF));
+        if constexpr (kBary) {
+            _mm_storeu_ps(u + p, _mm_andnot_ps(missF, _mm_loadu_ps(rh.hit.u + 4 * j)));
+            _mm_storeu_ps(v + p, _mm_andnot_ps(missF, _mm_loadu_ps(rh.hit.v + 4 * j)));
+        }
+        misses += std::popcount(unsigned(_mm_movemask_ps(missF)));
+    }
+    return uint64_t(16 - misses);
+}
+
 // One band of castPrimary (kBary: also write barycentrics; kTies: the context's filter tracks ties
 // per lane, reset per packet). `fc` is this band's own copy of the context (tie state is per packet).
 template <bool kBary, bool kTies>
@@ -342,11 +373,18 @@ void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int ban
     st.rays += count;
     uint64_t hits = 0, packets = 0;  // in registers, not through `st`
     const uint32_t *toSource = primToSource.data();
+    // The gather indexes in signed 32 bits.
+    const bool avx2 = __builtin_cpu_supports("avx2") && primToSource.size() <= size_t(INT32_MAX);
     rays.forEachPacket(band, [](int, int, int) {}, [&](int px, int py) {
         rays.fill(px, py, rh, valid);
         if constexpr (kTies) fc.resetLanes();
         rtcIntersect16(valid, scene, &fc.ctx, &rh);
         ++packets;
+        if (avx2 && px + kPacket <= img.width && py + kPacket <= img.height) {  // every lane valid
+            hits += storeWholePacketAvx2<kBary>(rh, toSource, size_t(py - y0) * w + size_t(px), w, id.get(), depth.get(),
+                                                u.get(), v.get());
+            return;
+        }
         // Branch-free over the lanes: a miss keeps tfar = far and geomID invalid, and Embree leaves
         // primID as it was (init()'s 0 or an earlier hit), always a valid index.
         for (int i = 0; i < 16; ++i) {
