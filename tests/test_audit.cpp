@@ -576,6 +576,63 @@ TEST(AuditCrossCheck, EdgeDistanceAnalytic) {
 
 // Classification of hand-made disagreements: a pixel well inside two triangles at different
 // depths is genuine; at equal depth a tie; at the shared edge of two triangles an edge.
+// The agreeing pixels' largest relative depth difference is the largest |ray - z| / z over every
+// agreeing pixel with an id and z > 0 (finite quotients only), whichever pixels the cross-check
+// skips the division for (one at a time or four at a time): ids agree everywhere, the depths
+// cover zero, negative, NaN, infinite and subnormal values and differences that grow and shrink
+// along the row, and the image's width leaves a partial group of four at the end.
+TEST(AuditCrossCheck, LargestRelativeDepthDifferenceOverEveryAgreeingPixel) {
+    Camera cam;
+    cam.width = 37;
+    cam.height = 29;
+    const size_t n = size_t(cam.width) * size_t(cam.height);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> depth(0.1, 500.0), rel(-1e-6, 1e-6);
+    for (int trial = 0; trial < 40; ++trial) {
+        std::vector<uint32_t> ids(n);
+        std::vector<double> z(n);
+        std::vector<float> ray(n);
+        for (size_t i = 0; i < n; ++i) {
+            ids[i] = rng() % 5 == 0 ? 0u : 1 + uint32_t(rng() % 1000);
+            z[i] = depth(rng);
+            // A difference that rises across the image now and then, so the maximum moves late too.
+            const double scale = (rng() % 50 == 0) ? 1e3 * double(i) / double(n) : 1.0;
+            ray[i] = float(z[i] * (1 + scale * rel(rng)));
+            switch (rng() % 64) {
+            case 0: z[i] = 0; break;
+            case 1: z[i] = -z[i]; break;
+            case 2: z[i] = std::numeric_limits<double>::quiet_NaN(); break;
+            case 3: z[i] = INFINITY; break;
+            case 4: z[i] = 1e-310; break;
+            case 5: ray[i] = std::numeric_limits<float>::quiet_NaN(); break;
+            case 6: ray[i] = float(z[i]); z[i] = double(ray[i]); break;  // no difference at all
+            default: break;
+            }
+        }
+        double want = 0;
+        for (size_t i = 0; i < n; ++i) {
+            if (!ids[i] || !(z[i] > 0)) continue;
+            const double q = std::fabs(double(ray[i]) - z[i]) / z[i];
+            if (std::isfinite(q)) want = std::max(want, q);
+        }
+        const Scene scene;
+        const CrossCheck c = crossCheck(ids, z, ids, ray, scene, cam, makeDepthEncoder(DepthFormat::f32, 0.1, 1000),
+                                        Vec3{0, 0, 0});
+        EXPECT_EQ(c.agree, n) << "trial " << trial;
+        EXPECT_EQ(c.maxRelativeDepthDifference, want) << "trial " << trial;
+    }
+    // A difference that rises by a hundred-thousandth of itself from pixel to pixel up to pixel 601
+    // and drops back after it (exact floats at depth 1): every pixel up to the peak raises the
+    // maximum, and the peak, inside a group of four, holds it.
+    std::vector<uint32_t> ids(n, 1);
+    std::vector<double> z(n, 1.0);
+    std::vector<float> ray(n);
+    for (size_t i = 0; i < n; ++i) ray[i] = float(1 + double(100000 + (i <= 601 ? i : 0)) * 0x1p-23);
+    const Scene scene;
+    const CrossCheck c = crossCheck(ids, z, ids, ray, scene, cam, makeDepthEncoder(DepthFormat::f32, 0.1, 1000), Vec3{0, 0, 0});
+    EXPECT_EQ(c.maxRelativeDepthDifference, double(100000 + 601) * 0x1p-23);
+}
+
 TEST(AuditCrossCheck, ClassifyHandMade) {
     SceneBuildInput in;
     in.materials.push_back(Material{});

@@ -7,6 +7,8 @@
 #include <limits>
 #include <unordered_map>
 
+#include <immintrin.h>
+
 #include "analysis/stages/backface.h"
 #include "render/raster.h"
 #include "render/raster_core.h"
@@ -680,6 +682,39 @@ Disagreement classifyDisagreement(EdgeDistanceMemo &memo, const DepthEncoder &en
     return Disagreement::genuine;
 }
 
+namespace {
+// crossCheck's common case four pixels at a time: from pixel i, whole groups of four in which the
+// two ids agree and no depth difference can raise the maximum M, each lane tested as crossCheck's
+// loop tests it (the same operations, so the same verdict), with M as it stands before the group:
+// M only grows, so a lane skipped against it is skipped against any later M too. Returns the first
+// pixel of the first group that needs the loop (or of the last partial group); *agree counts the
+// skipped pixels.
+__attribute__((target("avx2"))) size_t skipAgreeingAvx2(const uint32_t *za, const uint32_t *ra, const double *zd,
+                                                        const float *rd, size_t i, size_t n, double M, uint64_t *agree) {
+    const __m256d zero = _mm256_setzero_pd(), signless = _mm256_castsi256_pd(_mm256_set1_epi64x(INT64_MAX));
+    const __m256d tiny = _mm256_set1_pd(std::numeric_limits<double>::min()), shrink = _mm256_set1_pd(1 - 0x1p-50);
+    const __m256d max = _mm256_set1_pd(M);
+    const size_t start = i;
+    for (; i + 4 <= n; i += 4) {
+        const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i *>(za + i));
+        const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i *>(ra + i));
+        if (_mm_movemask_epi8(_mm_cmpeq_epi32(a, b)) != 0xFFFF) break;
+        const __m256d z = _mm256_loadu_pd(zd + i);
+        const __m256d diff = _mm256_and_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(rd + i)), z), signless);
+        const __m256d bound = _mm256_mul_pd(_mm256_mul_pd(max, z), shrink);
+        // Skipped: no id, or not z > 0, or diff == 0, or (bound >= the smallest normal and diff <= bound).
+        const __m256d noId = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm_cmpeq_epi32(a, _mm_setzero_si128())));
+        const __m256d skip = _mm256_or_pd(
+            _mm256_or_pd(noId, _mm256_cmp_pd(z, zero, _CMP_NGT_UQ)),
+            _mm256_or_pd(_mm256_cmp_pd(diff, zero, _CMP_EQ_OQ),
+                         _mm256_and_pd(_mm256_cmp_pd(bound, tiny, _CMP_GE_OQ), _mm256_cmp_pd(diff, bound, _CMP_LE_OQ))));
+        if (_mm256_movemask_pd(skip) != 0xF) break;
+    }
+    *agree += i - start;
+    return i;
+}
+}  // namespace
+
 CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector<double> &zbufferDepth,
                       const std::vector<uint32_t> &raycastIds, const std::vector<float> &raycastDepth,
                       const Scene &scene, const Camera &cam, const DepthEncoder &encoder, Vec3 rayOrigin) {
@@ -692,7 +727,15 @@ CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector
     c.cls.assign(n, uint8_t(Disagreement::none));
     constexpr size_t kExamples = 16;
     EdgeDistanceMemo memo(scene, cam, rayOrigin);
+    const bool avx2 = __builtin_cpu_supports("avx2") && zbufferDepth.size() >= n && raycastDepth.size() >= n;
+    size_t groupEnd = 0;  // the loop below runs pixels [i, groupEnd) one at a time
     for (size_t i = 0; i < n; ++i) {
+        if (avx2 && i == groupEnd) {
+            i = skipAgreeingAvx2(zbufferIds.data(), raycastIds.data(), zbufferDepth.data(), raycastDepth.data(), i, n,
+                                 c.maxRelativeDepthDifference, &c.agree);
+            if (i == n) break;
+            groupEnd = std::min(n, i + 4);
+        }
         const uint32_t a = zbufferIds[i], b = raycastIds[i];
         if (a == b) {
             ++c.agree;
