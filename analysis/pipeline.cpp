@@ -150,20 +150,28 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     RaycastResult &ray = *r.raycast;
     ray.image = ps.rays->castPrimary(c.cam, opt, &ray.stats);
     const uint64_t in = scene.objectTriangles.size();
-    uint64_t hit = 0;
-    std::vector<uint8_t> seen(scene.triangleCount(), 0);
-    for (uint32_t id : ray.image.id)
-        if (id && !seen[id - 1]) {
-            seen[id - 1] = 1;
-            ++hit;
-        }
     // Like with like: the z-buffer drew only what the culling stages kept (lists.triangles). Where
     // the whole-scene rays hit a triangle outside that set, cast again over the set itself, so
     // that a cull (judged by the culling audit) is never also counted as a disagreement.
     std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
     for (uint32_t t : lists.triangles) outOfSet[t] = 0;
-    uint64_t culledPixels = 0;
-    for (uint32_t id : ray.image.id) culledPixels += id && outOfSet[id - 1];
+    // The triangles the rays hit, and the pixels whose triangle is out of the set, in one pass; a
+    // pixel with its left neighbour's id (most of them) adds what that one added.
+    uint64_t hit = 0, culledPixels = 0;
+    std::vector<uint8_t> seen(scene.triangleCount(), 0);
+    uint32_t previous = 0, previousOut = 0;
+    for (const uint32_t id : ray.image.id) {
+        if (id != previous) {
+            previous = id;
+            previousOut = 0;
+            if (id) {
+                hit += seen[id - 1] ^ 1;
+                seen[id - 1] = 1;
+                previousOut = outOfSet[id - 1];
+            }
+        }
+        culledPixels += previousOut;
+    }
     RaycastImage sameSet;
     if (culledPixels > 0) {
         PrimaryOptions same = opt;
