@@ -34,13 +34,25 @@ DetailResult auditDetail(const Scene &scene, const Camera &cam, const std::vecto
         d.fragments += f;
         if (f == 0) ++d.trianglesNoCenter;
     }
-    for (uint32_t id : visibleIds) {
-        if (id == 0) continue;
-        const uint32_t o = scene.triangleObject[id - 1];
-        if (o == kExcludedTriangle) continue;
-        ++per[o].pixelsVisible;
-        ++r.pixelsVisible;
+    // Visible pixels per object, a run of equal ids at a time.
+    uint32_t runId = 0;
+    uint64_t run = 0;
+    auto endRun = [&] {
+        if (runId == 0) return;
+        const uint32_t o = scene.triangleObject[runId - 1];
+        if (o == kExcludedTriangle) return;
+        per[o].pixelsVisible += run;
+        r.pixelsVisible += run;
+    };
+    for (const uint32_t id : visibleIds) {
+        if (id == runId) {
+            ++run;
+            continue;
+        }
+        endRun();
+        runId = id, run = 1;
     }
+    endRun();
     for (uint32_t o = 0; o < n; ++o) {
         if (!drawn[o]) continue;
         DetailObject &d = per[o];
