@@ -400,20 +400,28 @@ CullAudit auditCulling(const Scene &scene, const ReferenceVisibility &ref, const
     // a stage also listed it: the z-buffer drew it).
     a.width = ref.width;
     a.height = ref.height;
-    a.fate.assign(ref.id.size(), kFateBackground);
-    for (size_t i = 0; i < ref.id.size(); ++i) {
-        const uint32_t id = ref.id[i];
-        if (!id) continue;
-        const uint32_t t = id - 1;
-        if (drawn[t]) a.fate[i] = kFateDrawn;
-        else if (culledBy[t] && isSnapped(t, culledBy[t] - 1)) a.fate[i] = kFateSnapped;
-        else if (culledBy[t] && !beyond.empty() && beyond[i]) a.fate[i] = kFateBeyondFarPlane;
-        else if (culledBy[t]) a.fate[i] = uint8_t(kFateCulledFirst + culledBy[t] - 1);
-        else {
-            a.fate[i] = kFateUnaccounted;
-            ++a.unaccountedPixels;
-        }
+    // Decided per triangle first; per pixel, only a falsely culled triangle's pixel beyond its
+    // stage's design far plane differs from its triangle's fate.
+    std::vector<uint8_t> fateOf(nt);
+    for (size_t t = 0; t < nt; ++t) {
+        if (drawn[t]) fateOf[t] = kFateDrawn;
+        else if (culledBy[t] && isSnapped(t, culledBy[t] - 1)) fateOf[t] = kFateSnapped;
+        else if (culledBy[t]) fateOf[t] = uint8_t(kFateCulledFirst + culledBy[t] - 1);
+        else fateOf[t] = kFateUnaccounted;
     }
+    a.fate.resize(ref.id.size());
+    const uint8_t *__restrict fateOfT = fateOf.data();
+    const uint32_t *__restrict ids = ref.id.data();
+    uint8_t *__restrict fate = a.fate.data();
+    uint64_t unaccounted = 0;
+    for (size_t i = 0, n = ref.id.size(); i < n; ++i) {
+        const uint32_t id = ids[i];
+        uint8_t f = id ? fateOfT[id - 1] : uint8_t(kFateBackground);
+        if (f >= kFateCulledFirst && !beyond.empty() && beyond[i]) f = kFateBeyondFarPlane;
+        unaccounted += f == kFateUnaccounted;
+        fate[i] = f;
+    }
+    a.unaccountedPixels += unaccounted;
     a.ms = t0.ms();
     return a;
 }
