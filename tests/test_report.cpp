@@ -959,7 +959,8 @@ TEST(ReportImages, PaletteImageWritesTheBytesOfItsRgbPixels) {
         int W, H, colors;
     };
     for (const Case c : {Case{300, 200, 6}, Case{300, 200, 255}, Case{300, 200, 256}, Case{300, 200, 257},
-                         Case{641, 480, 2000}, Case{1, 20000, 12}, Case{20000, 1, 12}, Case{1920, 1080, 40}}) {
+                         Case{641, 480, 2000}, Case{1, 20000, 12}, Case{20000, 1, 12}, Case{1920, 1080, 40},
+                         Case{800, 60, 200}, Case{800, 60, 300}}) {
         PaletteImage img(c.W, c.H, {24, 24, 24});
         // Codes asked for in reverse order of use, plus some never drawn.
         std::vector<uint16_t> code(size_t(c.colors));
@@ -970,7 +971,10 @@ TEST(ReportImages, PaletteImageWritesTheBytesOfItsRgbPixels) {
         }
         for (int y = 0; y < c.H; ++y)
             for (int x = 0; x < c.W; ++x) {
-                const int yy = y - y % 7, xx = x - x % 13;  // bands of repeated rows and runs
+                // Bands of repeated rows and runs (800 wide: runs of 37, longer than the 16 codes
+                // the index pass compares at once, and new colors where they end).
+                const int run = c.W == 800 ? 37 : 13;
+                const int yy = y - y % 7, xx = x - x % run;
                 img.code[size_t(y) * size_t(c.W) + size_t(x)] = code[size_t((yy * 31 + xx * 17) * 2654435761u % uint32_t(c.colors))];
             }
         img.fill(2, 2, 40, 9, Rgb8{255, 0, 255});
