@@ -13,6 +13,7 @@
 
 #include "analysis/stage.h"
 #include "common/fp_env.h"
+#include "common/id_runs.h"
 #include "analysis/stages/backface.h"
 #include "analysis/stages/cells.h"
 #include "analysis/load/level_views.h"
@@ -155,23 +156,16 @@ void runRaycast(ViewContext &c, const TriangleLists &lists) {
     // that a cull (judged by the culling audit) is never also counted as a disagreement.
     std::vector<uint8_t> outOfSet(scene.triangleCount(), 1);
     for (uint32_t t : lists.triangles) outOfSet[t] = 0;
-    // The triangles the rays hit, and the pixels whose triangle is out of the set, in one pass; a
-    // pixel with its left neighbour's id (most of them) adds what that one added.
+    // The triangles the rays hit, and the pixels whose triangle is out of the set, in one pass over
+    // the ids, a run of equal ids at a time (common/id_runs.h).
     uint64_t hit = 0, culledPixels = 0;
     std::vector<uint8_t> seen(scene.triangleCount(), 0);
-    uint32_t previous = 0, previousOut = 0;
-    for (const uint32_t id : ray.image.id) {
-        if (id != previous) {
-            previous = id;
-            previousOut = 0;
-            if (id) {
-                hit += seen[id - 1] ^ 1;
-                seen[id - 1] = 1;
-                previousOut = outOfSet[id - 1];
-            }
-        }
-        culledPixels += previousOut;
-    }
+    forEachIdRun(ray.image.id, [&](uint32_t id, uint64_t count) {
+        if (!id) return;
+        hit += seen[id - 1] ^ 1;
+        seen[id - 1] = 1;
+        culledPixels += outOfSet[id - 1] * count;
+    });
     RaycastImage sameSet;
     if (culledPixels > 0) {
         PrimaryOptions same = opt;

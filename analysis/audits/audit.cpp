@@ -10,6 +10,7 @@
 #include <immintrin.h>
 
 #include "analysis/stages/backface.h"
+#include "common/id_runs.h"
 #include "render/raster.h"
 #include "render/raster_core.h"
 #include "render/recycle.h"
@@ -234,22 +235,11 @@ ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, u
     r.fragments = sink.fragments;
     for (uint8_t f : r.snappedFront) r.snappedFrontTriangles += f;
 
-    // Pixels per triangle, a run of equal ids at a time (most pixels have their left neighbour's id,
-    // and an increment per pixel waits on the one before it in memory).
+    // Pixels per triangle, a run of equal ids at a time (common/id_runs.h).
     r.pixelsOf.assign(scene.triangleCount(), 0);
-    uint32_t runId = 0, run = 0;
-    auto endRun = [&] {
-        if (runId) r.pixelsOf[runId - 1] += run, r.coveredPixels += run;
-    };
-    for (const uint32_t id : r.id) {
-        if (id == runId) {
-            ++run;
-            continue;
-        }
-        endRun();
-        runId = id, run = 1;
-    }
-    endRun();
+    forEachIdRun(r.id, [&](uint32_t id, uint64_t count) {
+        if (id) r.pixelsOf[id - 1] += uint32_t(count), r.coveredPixels += count;
+    });
     std::vector<uint8_t> objectVisible(scene.objects.size(), 0);
     for (size_t t = 0; t < r.pixelsOf.size(); ++t)
         if (r.pixelsOf[t]) {

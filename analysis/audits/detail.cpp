@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "common/id_runs.h"
 #include "render/stopwatch.h"
 
 namespace va {
@@ -34,25 +35,14 @@ DetailResult auditDetail(const Scene &scene, const Camera &cam, const std::vecto
         d.fragments += f;
         if (f == 0) ++d.trianglesNoCenter;
     }
-    // Visible pixels per object, a run of equal ids at a time.
-    uint32_t runId = 0;
-    uint64_t run = 0;
-    auto endRun = [&] {
-        if (runId == 0) return;
-        const uint32_t o = scene.triangleObject[runId - 1];
+    // Visible pixels per object, a run of equal ids at a time (common/id_runs.h).
+    forEachIdRun(visibleIds, [&](uint32_t id, uint64_t count) {
+        if (id == 0) return;
+        const uint32_t o = scene.triangleObject[id - 1];
         if (o == kExcludedTriangle) return;
-        per[o].pixelsVisible += run;
-        r.pixelsVisible += run;
-    };
-    for (const uint32_t id : visibleIds) {
-        if (id == runId) {
-            ++run;
-            continue;
-        }
-        endRun();
-        runId = id, run = 1;
-    }
-    endRun();
+        per[o].pixelsVisible += count;
+        r.pixelsVisible += count;
+    });
     for (uint32_t o = 0; o < n; ++o) {
         if (!drawn[o]) continue;
         DetailObject &d = per[o];
