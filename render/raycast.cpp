@@ -216,9 +216,10 @@ struct PacketRays {
         }
     }
     // The rays of the packet whose top-left pixel is (px, py); lanes outside the image are invalid
-    // (lane i is pixel (px + i % 4, py + i / 4)).
-    void fill(int px, int py, RTCRayHit16 &rh, int valid[16]) const {
-        if (!gen.ortho && px + kPacket <= cam.width && py + kPacket <= cam.height) {
+    // (lane i is pixel (px + i % 4, py + i / 4)). True when every lane is valid.
+    bool fill(int px, int py, RTCRayHit16 &rh, int valid[16]) const {
+        const bool whole = px + kPacket <= cam.width && py + kPacket <= cam.height;
+        if (!gen.ortho && whole) {
             // A whole perspective packet: the origin is init()'s eye; the same operations in the
             // same order as combine(), four rays of a packet row at a time.
             const float far = float(cam.farZ);
@@ -236,7 +237,7 @@ struct PacketRays {
                     valid[l] = -1;
                 }
             }
-            return;
+            return true;
         }
         for (int i = 0; i < 16; ++i) {
             const int x = px + (i & 3), y = py + (i >> 2);
@@ -248,6 +249,7 @@ struct PacketRays {
             rh.ray.tfar[i] = float(cam.farZ);
             rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
         }
+        return whole;
     }
     int bands() const { return (cam.height + kTile - 1) / kTile; }
     // Calls fn(px, py) for the packets of band b in tracing order: tiles left to right, the 16
@@ -376,11 +378,11 @@ void castBand(RTCScene scene, FilterContext &fc, const PacketRays &rays, int ban
     // The gather indexes in signed 32 bits.
     const bool avx2 = __builtin_cpu_supports("avx2") && primToSource.size() <= size_t(INT32_MAX);
     rays.forEachPacket(band, [](int, int, int) {}, [&](int px, int py) {
-        rays.fill(px, py, rh, valid);
+        const bool whole = rays.fill(px, py, rh, valid);
         if constexpr (kTies) fc.resetLanes();
         rtcIntersect16(valid, scene, &fc.ctx, &rh);
         ++packets;
-        if (avx2 && px + kPacket <= img.width && py + kPacket <= img.height) {  // every lane valid
+        if (avx2 && whole) {
             hits += storeWholePacketAvx2<kBary>(rh, toSource, size_t(py - y0) * w + size_t(px), w, id.get(), depth.get(),
                                                 u.get(), v.get());
             return;

@@ -735,14 +735,16 @@ CrossCheck crossCheck(const std::vector<uint32_t> &zbufferIds, const std::vector
     c.cls.assign(n, uint8_t(Disagreement::none));
     constexpr size_t kExamples = 16;
     EdgeDistanceMemo memo(scene, cam, rayOrigin);
+    // Where the next whole groups of four may be skipped (n: never); the group the skip stops at
+    // runs one pixel at a time.
     const bool avx2 = __builtin_cpu_supports("avx2") && zbufferDepth.size() >= n && raycastDepth.size() >= n;
-    size_t groupEnd = 0;  // the loop below runs pixels [i, groupEnd) one at a time
+    size_t skipFrom = avx2 ? 0 : n;
     for (size_t i = 0; i < n; ++i) {
-        if (avx2 && i == groupEnd) {
+        if (i == skipFrom) {
             i = skipAgreeingAvx2(zbufferIds.data(), raycastIds.data(), zbufferDepth.data(), raycastDepth.data(), i, n,
                                  c.maxRelativeDepthDifference, &c.agree);
             if (i == n) break;
-            groupEnd = std::min(n, i + 4);
+            skipFrom = i + 4;
         }
         const uint32_t a = zbufferIds[i], b = raycastIds[i];
         if (a == b) {
