@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <limits>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -378,6 +380,68 @@ void checkScene(const Scene &s, const std::vector<ViewSpec> &views, const std::s
         }
     }
     if (tree.stats.splits) EXPECT_GT(splitFragments, 0u) << what << ": no view saw a split triangle";
+}
+
+// The reference's resolve also draws the submitted order (FragmentCache::SubmittedDraw): on random
+// fragments whose sources do not ascend with the screen triangles and whose depths tie often (and
+// include +inf and NaN), its ids, depths, passes, covered pixels and the pixels where the submitted
+// ids differ are those of drawing every fragment in order, pixel by pixel, under both rules.
+TEST(Ordering, SubmittedDrawFromTheResolveMatchesDrawingInOrder) {
+    std::mt19937 rng(20261129);
+    const double depths[] = {1.0, 2.0, 2.0, 3.0, 0.5, std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::quiet_NaN()};
+    uint64_t differing = 0;
+    for (int round = 0; round < 40; ++round) {
+        const size_t width = 5 + rng() % 40, height = 1 + rng() % 70, pixels = width * height;
+        const size_t tris = 1 + rng() % 80;
+        FragmentCache cache;
+        std::vector<uint32_t> source(tris);
+        cache.begin.push_back(0);
+        for (size_t t = 0; t < tris; ++t) {
+            source[t] = uint32_t(rng() % 50);
+            std::vector<uint32_t> px;
+            const size_t n = rng() % 3 == 0 ? 0 : rng() % (pixels / 2 + 1);
+            for (size_t k = 0; k < n; ++k) px.push_back(uint32_t(rng() % pixels));
+            std::sort(px.begin(), px.end());
+            px.erase(std::unique(px.begin(), px.end()), px.end());
+            for (uint32_t p : px) {
+                cache.pixel.push_back(p);
+                cache.depth.push_back(depths[rng() % std::size(depths)]);
+            }
+            cache.begin.push_back(cache.pixel.size());
+        }
+        // Every fragment in order, per pixel: the reference's rule and the submitted draw's.
+        std::vector<uint32_t> refId(pixels, 0), subId(pixels, 0);
+        std::vector<double> refDepth(pixels, std::numeric_limits<double>::infinity());
+        uint64_t passes = 0, covered = 0;
+        for (size_t t = 0; t < tris; ++t)
+            for (uint64_t f = cache.begin[t]; f < cache.begin[t + 1]; ++f) {
+                const uint32_t p = cache.pixel[f], cur = source[t] + 1;
+                const double d = cache.depth[f], old = refDepth[p];
+                if (d < old) {
+                    ++passes;
+                    covered += old == std::numeric_limits<double>::infinity();
+                    subId[p] = cur;
+                }
+                if (d < old || (d == old && cur < refId[p])) refDepth[p] = d, refId[p] = cur;
+            }
+        std::vector<std::pair<uint32_t, uint32_t>> differs;
+        for (size_t p = 0; p < pixels; ++p)
+            if (subId[p] != refId[p]) differs.push_back({uint32_t(p), subId[p]});
+
+        std::vector<uint32_t> id(pixels, 0);
+        std::vector<double> depth(pixels, std::numeric_limits<double>::infinity());
+        resolveFromCache(cache, source.data(), width, height, id.data(), depth.data());
+        EXPECT_EQ(id, refId) << "round " << round;
+        for (size_t p = 0; p < pixels; ++p)
+            ASSERT_EQ(std::bit_cast<uint64_t>(depth[p]), std::bit_cast<uint64_t>(refDepth[p])) << "round " << round;
+        EXPECT_EQ(cache.submitted.fragments, cache.pixel.size());
+        EXPECT_EQ(cache.submitted.passes, passes) << "round " << round;
+        EXPECT_EQ(cache.submitted.covered, covered) << "round " << round;
+        EXPECT_EQ(cache.submitted.differs, differs) << "round " << round;
+        differing += differs.size();
+    }
+    EXPECT_GT(differing, 0u) << "no round made the two rules differ";
 }
 
 TEST(OrderingScenes, Demo) {

@@ -86,28 +86,58 @@ struct ReferenceSink {
     }
 };
 
-// The reference's depth test (LESS on the double depth, ties to the lowest id) over the cached
-// fragments, band by band (forEachCachedFragmentByBand): the band's slice of the depth and id
-// buffers (370 KB at 1080p) stays in the core's L2 instead of the walk's random access into 24 MB.
-// The rule does not depend on the order of the fragments, so the result is the walk's.
-void resolveFromCache(const FragmentCache &cache, const uint32_t *source, size_t width, size_t height, uint32_t *id,
-                      double *depth) {
-    forEachCachedFragmentByBand(cache, width, height, [&](uint32_t i, uint32_t t, double d) {
-        const uint32_t current = source[t] + 1;
-        const double old = depth[i];
-        if (d < old || (d == old && current < id[i])) {
-            depth[i] = d;
-            id[i] = current;
-        }
-    });
-}
-
 // Unit roundoff of float (Embree's arithmetic) and pbrt's gamma(n) = n u / (1 - n u): a bound on
 // the relative error of n successive roundings.
 constexpr double kFloatU = 0x1p-24;
 constexpr double gammaF(int n) { return n * kFloatU / (1 - n * kFloatU); }
 
 }  // namespace
+
+// The reference's depth test (LESS on the double depth, ties to the lowest id) over the cached
+// fragments, band by band (forEachCachedFragmentByBand): the band's slice of the depth and id
+// buffers (370 KB at 1080p) stays in the core's L2 instead of the walk's random access into 24 MB.
+// The rule does not depend on the order of the fragments, so the result is the walk's. The same
+// pass draws the submitted order (FragmentCache::SubmittedDraw): its passes are the fragments
+// strictly nearer than the pixel's depth so far, which both rules keep; its ids are kept for the
+// band only and compared with the reference's when the band is done.
+void resolveFromCache(FragmentCache &cache, const uint32_t *source, size_t width, size_t height, uint32_t *id,
+                      double *depth) {
+    const Stopwatch t0;
+    FragmentCache::SubmittedDraw &sub = cache.submitted;
+    sub.fragments = sub.passes = sub.covered = 0;
+    sub.differs.clear();
+    thread_local std::vector<uint32_t> bandIds;  // the submitted ids of the band: pixel - p0
+    bandIds.assign(kFragmentBandRows * width, 0);
+    size_t p0 = 0;
+    uint64_t passes = 0, covered = 0;
+    uint32_t *subId = bandIds.data();
+    forEachCachedFragmentByBand(
+        cache, width, height,
+        [&](uint32_t i, uint32_t t, double d) {
+            const uint32_t current = source[t] + 1;
+            const double old = depth[i];
+            if (d < old) {
+                ++passes;
+                covered += old == std::numeric_limits<double>::infinity();
+                subId[i - p0] = current;
+                depth[i] = d;
+                id[i] = current;
+            } else if (d == old && current < id[i]) {
+                id[i] = current;
+            }
+        },
+        [&](size_t b0, size_t b1) {
+            for (size_t p = b0; p < b1; ++p) {
+                if (subId[p - b0] != id[p]) sub.differs.push_back({uint32_t(p), subId[p - b0]});
+                subId[p - b0] = 0;
+            }
+            p0 = b1;
+        });
+    sub.fragments = cache.pixel.size();
+    sub.passes = passes;
+    sub.covered = covered;
+    sub.ms = t0.ms();
+}
 
 ViewTriangle viewTriangle(const Scene &scene, const Camera &cam, Vec3 rayOrigin, uint32_t t) {
     ViewTriangle v;
@@ -179,6 +209,7 @@ void recycleFragmentCache(FragmentCache &c) {
     kept.pixel.clear();
     kept.depth.clear();
     kept.rasterMs = 0;
+    kept.submitted.differs.clear();
     recyclerOf<FragmentCache>().give(std::move(kept));
 }
 

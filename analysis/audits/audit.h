@@ -43,6 +43,18 @@ struct FragmentCache {
     std::vector<double> depth;
     double rasterMs = 0;            // the rasterization that recorded them (walk + record)
     bool complete() const { return !begin.empty(); }
+
+    // Every fragment drawn in submission order (ascending t) with LESS on the double depth, the
+    // first drawn of equal depths staying: the ordering audit's "submitted" draw and its z-buffer
+    // row. The reference's resolve runs it in the same pass over the fragments, because the two
+    // keep the same depth at every pixel (the nearest) and differ in the id only where a later
+    // fragment ties the nearest depth with a lower id (the reference keeps the lowest id).
+    struct SubmittedDraw {
+        uint64_t fragments = 0, passes = 0, covered = 0;
+        // The pixels whose submitted id differs from the reference's, ascending, with that id.
+        std::vector<std::pair<uint32_t, uint32_t>> differs;
+        double ms = 0;  // its share of the resolve's pass (the resolve's whole time)
+    } submitted;
 };
 
 // Fragments are replayed 16 rows at a time (forEachCachedFragmentByBand; the ordering audit's
@@ -73,8 +85,9 @@ void bandLists(size_t runs, size_t bands, BandsOf &&bandsOf, std::vector<uint32_
 // band, and within a band triangle by triangle in ascending t: each pixel sees its fragments in the
 // walk's order. A triangle's fragments come in ascending pixel order (raster_core.h), so a band's
 // are a stretch of its range, resumed in the next band.
-template <class Fn>
-void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_t height, Fn &&fn) {
+// bandDone(p0, p1) follows the last fragment of the band of pixels [p0, p1).
+template <class Fn, class BandDone>
+void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_t height, Fn &&fn, BandDone &&bandDone) {
     const size_t bandPixels = kFragmentBandRows * width;
     const size_t bands = width ? (height + kFragmentBandRows - 1) / kFragmentBandRows : 0;
     if (bands == 0 || cache.begin.empty()) return;
@@ -95,7 +108,12 @@ void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_
             for (; f < end && pixelOf[f] < p1; ++f) fn(pixelOf[f], t, depthOf[f]);
             at[t] = f;
         }
+        bandDone(b * bandPixels, size_t(p1));
     }
+}
+template <class Fn>
+void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_t height, Fn &&fn) {
+    forEachCachedFragmentByBand(cache, width, height, fn, [](size_t, size_t) {});
 }
 
 struct ReferenceVisibility {
@@ -122,6 +140,11 @@ struct ReferenceVisibility {
 // `maxCachedFragments` > 0 keeps every fragment in `fragments` as long as there are at most that
 // many (12 bytes each); more, and fragmentCache stays empty (its users rasterize again: same results).
 ReferenceVisibility referenceVisibility(const Scene &scene, const Camera &cam, uint64_t maxCachedFragments = 0);
+// The reference's depth test over a complete cache of a width x height view: id and depth (its
+// buffers, 0 and +inf before) get the nearest fragment of each pixel, ties to the lowest source
+// (source[t]: screen triangle t's); cache.submitted gets the submitted draw, in the same pass.
+void resolveFromCache(FragmentCache &cache, const uint32_t *source, size_t width, size_t height, uint32_t *id,
+                      double *depth);
 // Gives a fragment cache's storage back for the next referenceVisibility to record into
 // (render/recycle.h): a 1080p view's cache is ~100 MB, and faulting fresh pages in for every view
 // cost the walk as much as recording into them. `c` is left empty.

@@ -125,14 +125,29 @@ OrderingView prepareOrderingView(const Scene &scene, const Camera &cam, const Re
     return v;
 }
 
+namespace {
+// The class of pixel p, where a method shows id a and the reference id b != a (both 1 + source, 0
+// for the background): a tie when both are triangles at exactly the same depth there, an edge
+// pixel within the coverage uncertainty of either one's boundary, wrong otherwise.
+uint8_t classifyDifferingPixel(const OrderingView &v, EdgeDistanceMemo &edgeAt, size_t p, uint32_t a, uint32_t b) {
+    const size_t w = size_t(std::max(v.cam.width, 1));
+    const double px = double(p % w) + 0.5, py = double(p / w) + 0.5;
+    if (a && b && viewDepthAt(v.cam, planeOfSource(v, a - 1), px, py) == viewDepthAt(v.cam, planeOfSource(v, b - 1), px, py))
+        return kOrderTie;
+    // Within the coverage uncertainty of either triangle's boundary (the float frame of the
+    // edge bound at the eye: the rasterizer's snapping dominates).
+    const bool edge = (a && edgeAt.nearEdge(a - 1, px, py)) || (b && edgeAt.nearEdge(b - 1, px, py));
+    return edge ? kOrderEdge : kOrderWrong;
+}
+void countClass(PixelComparison &c, uint8_t k) {
+    (k == kOrderTie ? c.tiePixels : k == kOrderEdge ? c.edgePixels : c.wrongPixels)++;
+}
+}  // namespace
+
 PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
                                      std::span<const uint32_t> ids, bool keepClasses) {
     PixelComparison c;
     if (keepClasses) c.cls.assign(ids.size(), kOrderRight);
-    auto classify = [&](size_t p, uint8_t k) {
-        if (keepClasses) c.cls[p] = k;
-    };
-    const size_t w = size_t(std::max(v.cam.width, 1));
     const size_t n = std::min(ids.size(), ref.id.size());
     const uint32_t *A = ids.data(), *B = ref.id.data();
     EdgeDistanceMemo edgeAt(*v.scene, v.cam, v.cam.eye);
@@ -148,19 +163,18 @@ PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisib
         }
         const uint32_t a = A[p], b = B[p];
         if (a == b) continue;
-        const double px = double(p % w) + 0.5, py = double(p / w) + 0.5;
-        if (a && b &&
-            viewDepthAt(v.cam, planeOfSource(v, a - 1), px, py) == viewDepthAt(v.cam, planeOfSource(v, b - 1), px, py)) {
-            classify(p, kOrderTie);
-            ++c.tiePixels;
-            continue;
-        }
-        // Within the coverage uncertainty of either triangle's boundary (the float frame of the
-        // edge bound at the eye: the rasterizer's snapping dominates).
-        const bool edge = (a && edgeAt.nearEdge(a - 1, px, py)) || (b && edgeAt.nearEdge(b - 1, px, py));
-        classify(p, edge ? kOrderEdge : kOrderWrong);
-        (edge ? c.edgePixels : c.wrongPixels)++;
+        const uint8_t k = classifyDifferingPixel(v, edgeAt, p, a, b);
+        if (keepClasses) c.cls[p] = k;
+        countClass(c, k);
     }
+    return c;
+}
+
+PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
+                                     std::span<const std::pair<uint32_t, uint32_t>> differs) {
+    PixelComparison c;
+    EdgeDistanceMemo edgeAt(*v.scene, v.cam, v.cam.eye);
+    for (const auto &[p, a] : differs) countClass(c, classifyDifferingPixel(v, edgeAt, p, a, ref.id[p]));
     return c;
 }
 
@@ -639,6 +653,18 @@ void drawCached(const OrderingView &v, std::span<DrawJob> jobs) {
     }
 }
 
+// The submitted draw's stats, as BandedDraw::finish gives them, from the reference's resolve.
+DrawStats submittedStats(const FragmentCache &fc) {
+    DrawStats st;
+    st.fragments = fc.submitted.fragments;
+    st.depthPasses = fc.submitted.passes;
+    st.coveredPixels = fc.submitted.covered;
+    st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+    st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+    st.ms = fc.submitted.ms + fc.rasterMs;
+    return st;
+}
+
 // One draw: the items in order, or (reverse) from the last to the first.
 DrawStats drawCached(const OrderingView &v, const std::vector<DrawItem> &items, bool depthTest,
                      const ItemFragments *sel, UninitVector<uint32_t> *idsOut, bool reverse = false) {
@@ -1081,7 +1107,6 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
     // six draws run band by band together in five passes (the painter's and the back-to-front
     // one are one pass over the same fragments), and the submitted draw is also the z-buffer row
     // below (kept ids).
-    UninitVector<uint32_t> submittedIds;
     {
         std::vector<DrawItem> backToFront;
         std::vector<uint32_t> painterSorted;
@@ -1124,19 +1149,20 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
                 const BspViewPlanes planes = bspItems(v, tree, bspItemList, r.bsp);
                 bspSelectMs = bspSelect(v, tree, planes, bspItemList, bspSel);
             }
+            // The submitted draw was drawn by the reference's resolve (FragmentCache::SubmittedDraw).
             // The painter's draw is back_to_front's pass (paint): the same items in the same order.
-            DrawJob jobs[5];
-            for (int k = 0; k < 3; ++k)
-                jobs[k] = drawJob(*orders[k], nullptr, true, false, k == 0 ? &submittedIds : nullptr);
-            jobs[1].paint = true;
-            jobs[1].idsOut = &r.painter.id;
-            bspJobs(bspItemList, bspSel, r.bsp, jobs + 3);
+            DrawJob jobs[4];
+            for (int k = 1; k < 3; ++k) jobs[k - 1] = drawJob(*orders[k], nullptr, true, false, nullptr);
+            jobs[0].paint = true;
+            jobs[0].idsOut = &r.painter.id;
+            bspJobs(bspItemList, bspSel, r.bsp, jobs + 2);
             drawCached(v, jobs);
-            for (int k = 0; k < 3; ++k) jobs[k].stats.ms += v.fragments->rasterMs;
-            jobs[1].paintStats.ms += v.fragments->rasterMs;
-            finishPainter(v, ref, painterSorted, settings.overlapTests, jobs[1].paintStats, r.painter);
-            for (int k = 0; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k].stats});
-            bspTakeDraws(jobs + 3, bspSelectMs, r.bsp);
+            for (int k = 0; k < 2; ++k) jobs[k].stats.ms += v.fragments->rasterMs;
+            jobs[0].paintStats.ms += v.fragments->rasterMs;
+            finishPainter(v, ref, painterSorted, settings.overlapTests, jobs[0].paintStats, r.painter);
+            r.overdrawByOrder.push_back({names[0], submittedStats(*v.fragments)});
+            for (int k = 1; k < 3; ++k) r.overdrawByOrder.push_back({names[k], jobs[k - 1].stats});
+            bspTakeDraws(jobs + 2, bspSelectMs, r.bsp);
             bspCompare(v, ref, r.bsp);
         } else {
             for (int k = 0; k < 3; ++k)
@@ -1168,7 +1194,7 @@ OrderingResult analyzeOrdering(const Scene &scene, const Camera &cam, const Refe
         const uint64_t covered = r.painter.coveredPixels;
         const DrawStats &sub = r.overdrawByOrder[0].stats;
         zrow.drawMs = sub.ms;
-        const PixelComparison c = compareWithReference(v, ref, submittedIds, false);
+        const PixelComparison c = compareWithReference(v, ref, v.fragments->submitted.differs);
         zrow.wrongPixels = c.wrongPixels;
         zrow.tiePixels = c.tiePixels;
         zrow.edgePixels = c.edgePixels;

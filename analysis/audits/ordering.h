@@ -71,6 +71,10 @@ struct PixelComparison {
 };
 PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
                                      std::span<const uint32_t> ids, bool keepClasses = true);
+// The same counts for a method whose ids differ from the reference's only at `differs` (pixel,
+// the method's id; FragmentCache::SubmittedDraw::differs), without classes.
+PixelComparison compareWithReference(const OrderingView &v, const ReferenceVisibility &ref,
+                                     std::span<const std::pair<uint32_t, uint32_t>> differs);
 
 // ---- Painter's algorithm ------------------------------------------------------------------------
 
