@@ -239,7 +239,12 @@ inline void coverTriangle(int64_t x0, int64_t y0, int64_t x1, int64_t y1, int64_
                 else if (r[k] < 0) hi = -1;
             }
             const size_t row = size_t(y) * W;
-            for (int64_t x = bx0 + lo; x <= bx0 + hi; ++x) frag(row + size_t(x), x, y);
+            // A callback that takes a whole row's span (frag.span) gets it in one call.
+            if constexpr (requires { frag.span(row, bx0, bx1, y); }) {
+                if (lo <= hi) frag.span(row, bx0 + lo, bx0 + hi, y);
+            } else {
+                for (int64_t x = bx0 + lo; x <= bx0 + hi; ++x) frag(row + size_t(x), x, y);
+            }
             r0 += e0.stepY;
             r1 += e1.stepY;
             r2 += e2.stepY;
@@ -286,6 +291,30 @@ template <bool kPerspective, class Sink>
     else sink.fragment(idx, t, kPerspective ? 1.0 / v : v);
 }
 
+// The fragment callback of shadeTriangle: the depth plane's value at each covered center. A sink
+// with fragmentSpan(row, x0, x1, pa, rowTerm, pc) (and kPlaneValue) takes a row's span of centers
+// x0..x1 in one call, to compute (pa * (x + 0.5) + rowTerm) + pc itself, rowTerm = pb * (y + 0.5):
+// the same operations in the same order as per center, so the same values.
+template <bool kPerspective, class Sink>
+struct ShadeFragments {
+    Sink &sink;
+    size_t t;
+    double pa, pb, pc;
+    uint64_t count = 0;
+
+    [[gnu::always_inline]] void operator()(size_t idx, int64_t x, int64_t y) {
+        const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
+        ++count;
+        emitFragment<kPerspective>(sink, idx, t, pv);
+    }
+    [[gnu::always_inline]] void span(size_t row, int64_t x0, int64_t x1, int64_t y)
+        requires requires(Sink &s) { s.fragmentSpan(size_t(0), int64_t(0), int64_t(0), 0.0, 0.0, 0.0); }
+    {
+        count += uint64_t(x1 - x0 + 1);
+        sink.fragmentSpan(row, x0, x1, pa, pb * (double(y) + 0.5), pc);
+    }
+};
+
 // Steps 2-5 of the walk below for triangle t once its coverage is known: the depth plane (invalid:
 // nothing), beginTriangle, then for every covered center -- `cover(frag)` calls frag(pixel, x, y)
 // once per center -- the depth straight from the plane exactly as evalDepthPlane writes it
@@ -296,14 +325,9 @@ template <bool kPerspective, class Sink, class Cover>
     const DepthPlane &plane = tris.planes[tris.plane[t]];
     if (!plane.valid) return;
     if (!sink.beginTriangle(t, frontWinding)) return;
-    uint64_t triFragments = 0;
-    const double pa = plane.a, pb = plane.b, pc = plane.c;
-    cover([&](size_t idx, int64_t x, int64_t y) {
-        const double pv = (pa * (double(x) + 0.5) + pb * (double(y) + 0.5)) + pc;
-        ++triFragments;
-        emitFragment<kPerspective>(sink, idx, t, pv);
-    });
-    sink.endTriangle(t, triFragments);
+    ShadeFragments<kPerspective, Sink> frag{sink, t, plane.a, plane.b, plane.c};
+    cover(frag);
+    sink.endTriangle(t, frag.count);
 }
 
 // Steps 2-5 for triangle t, whose step 1 (setupTriangle) gave ts: coverage by coverTriangle.
