@@ -23,6 +23,10 @@
 #include <cstddef>
 #include <cstdint>
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include "render/depth_format_impl.h"
 #include "render/raster_core.h"
 
@@ -209,10 +213,65 @@ struct FragmentBatch {
         }
         const PixelBuffers b = buf;
         uint64_t p = 0;
-        for (size_t i = 0; i < n; ++i) p += b.resolve<kExact>(pixel[i], kExact ? 0 : keys[i], value[i], ids[i]) ? 1 : 0;
+        for (size_t i = 0; i < n;) {
+#if defined(__AVX2__)
+            // Eight fragments on eight consecutive pixels (a span's, mostly) are eight different
+            // pixels: resolved side by side, each as resolve() does it.
+            if (i + 8 <= n && pixel[i + 7] == pixel[i] + 7) {
+                const __m256i px = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(pixel + i));
+                const __m256i steps = _mm256_sub_epi32(px, _mm256_set1_epi32(int32_t(pixel[i])));
+                if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(steps, _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7))) == -1) {
+                    p += resolveEight(b, pixel[i], i);
+                    i += 8;
+                    continue;
+                }
+            }
+#endif
+            p += b.resolve<kExact>(pixel[i], kExact ? 0 : keys[i], value[i], ids[i]) ? 1 : 0;
+            ++i;
+        }
         passes += p;
         n = 0;
     }
+
+#if defined(__AVX2__)
+    // Fragments i..i+7 of the batch, on pixels at..at+7: PixelBuffers::resolve for each, in AVX2
+    // lanes (saturating adds for the 16-bit counters, unsigned LESS on the keys by flipping the sign
+    // bit, or LESS on the doubles with kExact, false on NaN as the scalar test). Returns the passes.
+    [[gnu::always_inline]] unsigned resolveEight(const PixelBuffers &b, size_t at, size_t i) const {
+        const __m128i one16 = _mm_set1_epi16(1);
+        __m128i *frags = reinterpret_cast<__m128i *>(b.fragments + at);
+        _mm_storeu_si128(frags, _mm_adds_epu16(_mm_loadu_si128(frags), one16));
+        const __m256d d0 = _mm256_loadu_pd(value + i), d1 = _mm256_loadu_pd(value + i + 4);
+        const __m256d od0 = _mm256_loadu_pd(b.depth + at), od1 = _mm256_loadu_pd(b.depth + at + 4);
+        __m256i pass;
+        if constexpr (kExact) {
+            // The low halves of the 64-bit masks, in lane order.
+            const __m256i low = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+            const __m256i m0 = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(_mm256_cmp_pd(d0, od0, _CMP_LT_OQ)), low);
+            const __m256i m1 = _mm256_permutevar8x32_epi32(_mm256_castpd_si256(_mm256_cmp_pd(d1, od1, _CMP_LT_OQ)), low);
+            pass = _mm256_blend_epi32(m0, m1, 0xF0);
+        } else {
+            const __m256i sign = _mm256_set1_epi32(INT32_MIN);
+            __m256i *key = reinterpret_cast<__m256i *>(b.key + at);
+            const __m256i oldKey = _mm256_loadu_si256(key), newKey = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(keys + i));
+            pass = _mm256_cmpgt_epi32(_mm256_xor_si256(oldKey, sign), _mm256_xor_si256(newKey, sign));
+            _mm256_storeu_si256(key, _mm256_blendv_epi8(oldKey, newKey, pass));
+        }
+        __m256i *id = reinterpret_cast<__m256i *>(b.id + at);
+        _mm256_storeu_si256(id, _mm256_blendv_epi8(_mm256_loadu_si256(id),
+                                                   _mm256_loadu_si256(reinterpret_cast<const __m256i *>(ids + i)), pass));
+        const __m256d pass0 = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm256_castsi256_si128(pass)));
+        const __m256d pass1 = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(_mm256_extracti128_si256(pass, 1)));
+        _mm256_storeu_pd(b.depth + at, _mm256_blendv_pd(od0, d0, pass0));
+        _mm256_storeu_pd(b.depth + at + 4, _mm256_blendv_pd(od1, d1, pass1));
+        // The pass mask as eight 16-bit lanes of 1 or 0.
+        const __m128i pass16 = _mm_packs_epi32(_mm256_castsi256_si128(pass), _mm256_extracti128_si256(pass, 1));
+        __m128i *passes16 = reinterpret_cast<__m128i *>(b.passes + at);
+        _mm_storeu_si128(passes16, _mm_adds_epu16(_mm_loadu_si128(passes16), _mm_and_si128(pass16, one16)));
+        return unsigned(std::popcount(unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(pass)))));
+    }
+#endif
 };
 
 // The batched walk's z-buffer sink: ZBufferSink's counts, fragments through a FragmentBatch

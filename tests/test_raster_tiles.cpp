@@ -195,6 +195,37 @@ TEST(RasterTiles, OptionsMatchPlainWalk) {
         }
 }
 
+// Wide spans resolved eight pixels at a time (FragmentBatch::resolveEight) keep the per-pixel
+// counters saturating at 65535: 70,000 copies of a triangle over rows of 20 to 40 centers, each copy
+// nearer than the last (every fragment passes) or all at one depth (only the first does), keyed and
+// exact, against the plain walk.
+TEST(RasterTiles, WideSpansSaturateAsThePlainWalk) {
+    const int W = 48, H = 6, n = 70000;
+    for (bool nearer : {true, false}) {
+        ScreenTriangles tris;
+        for (int i = 0; i < n; ++i) {
+            for (double c : {2.0, 0.0, 46.0, 0.0, 2.0, 6.0}) tris.xy.push_back(toFixed(c));
+            tris.source.push_back(uint32_t(3 * i));
+            tris.plane.push_back(uint32_t(tris.planes.size()));
+            tris.planes.push_back({0.01, 0.02, nearer ? 150.0 - 0.001 * i : 90.0, true});
+        }
+        for (bool exact : {false, true}) {
+            ZBufferSettings s;
+            s.encoder = makeDepthEncoder(DepthFormat::f32, 0.5, 200);
+            s.orthographic = true;
+            s.exactDepth = exact;
+            const ZBufferResult want = rasterizeOn(1, tris, W, H, s, {Path::plainWalk, true, 0});
+            ASSERT_EQ(want.stats.maxDepthComplexity, 65535u);
+            // Exact: every nearer double passes. Keyed: f32 keys of depths 0.001 apart tie at times.
+            if (exact || !nearer) EXPECT_EQ(want.buffer.passes[2 * W + 10], nearer ? 65535 : 1);
+            else EXPECT_GT(want.buffer.passes[2 * W + 10], 40000);
+            const std::string what = std::string(nearer ? "nearer" : "equal") + (exact ? " exact" : " keyed");
+            expectIdentical(rasterizeOn(1, tris, W, H, s, {Path::batchedWalk, true, 0}), want, what + " batched walk");
+            expectIdentical(rasterizeOn(2, tris, W, H, s, {}), want, what + " default");
+        }
+    }
+}
+
 // The benchmark scene (1,000,002 triangles), its camera and every triangle in order.
 struct BenchInput {
     RawMesh mesh = sphereGridMesh();
