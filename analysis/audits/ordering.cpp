@@ -463,6 +463,12 @@ void selectFragments(const OrderingView &v, const std::vector<DrawItem> &items, 
 // writes, and the ids count the covered pixels.
 constexpr size_t kBandRows = kFragmentBandRows;
 
+// A draw's overdraw (passes per covered pixel) and depth complexity (fragments per covered pixel).
+void setRatios(DrawStats &st) {
+    st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
+    st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+}
+
 struct DrawJob {
     const std::vector<DrawItem> *items = nullptr;
     const ItemFragments *sel = nullptr;  // its listed items' fragments; null: every item whole
@@ -593,16 +599,12 @@ struct BandedDraw {
 
     // The job's stats (and, with paint, job.paintStats); ms is left to the caller.
     DrawStats finish(DrawJob &job) {
-        auto ratios = [](DrawStats &st) {
-            st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
-            st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
-        };
         // Without the depth test every fragment writes, and the ids count the covered pixels.
         auto paintedStats = [&]() {
             DrawStats st;
             st.fragments = st.depthPasses = fragments;
             st.coveredPixels = painted;
-            ratios(st);
+            setRatios(st);
             return st;
         };
         DrawStats st;
@@ -610,7 +612,7 @@ struct BandedDraw {
             st.fragments = fragments;
             st.depthPasses = passes;
             st.coveredPixels = covered;
-            ratios(st);
+            setRatios(st);
             if (job.paint) job.paintStats = paintedStats();
         } else {
             st = paintedStats();
@@ -659,8 +661,7 @@ DrawStats submittedStats(const FragmentCache &fc) {
     st.fragments = fc.submitted.fragments;
     st.depthPasses = fc.submitted.passes;
     st.coveredPixels = fc.submitted.covered;
-    st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
-    st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+    setRatios(st);
     st.ms = fc.submitted.ms + fc.rasterMs;
     return st;
 }
@@ -715,8 +716,7 @@ DrawStats drawInOrder(const OrderingView &v, const std::vector<DrawItem> &items,
     st.fragments = sink.fragments;
     st.depthPasses = sink.passes;
     for (uint32_t i : id) st.coveredPixels += i != 0;
-    st.overdraw = st.coveredPixels ? double(st.depthPasses) / double(st.coveredPixels) : 0;
-    st.depthComplexity = st.coveredPixels ? double(st.fragments) / double(st.coveredPixels) : 0;
+    setRatios(st);
     st.ms = t0.ms();
     if (idsOut) *idsOut = std::move(id);
     return st;
