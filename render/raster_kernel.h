@@ -54,7 +54,9 @@ struct BinList {
 // resolved into them: resolve() counts the fragment at the pixel, runs LESS on the keys (kExact: on
 // the double depths; on equal values the first drawn fragment stays) and on a pass writes key, id
 // and depth and counts the pass. Written as selects, not branches: about half the fragments pass,
-// in no predictable pattern. Counters saturate at 0xFFFF.
+// in no predictable pattern. Counters saturate at 0xFFFF. FragmentBatch::resolveEight is the same
+// rule for eight consecutive pixels in AVX2 lanes (it lives in the instruction-set namespace, where
+// AVX2 code may differ between the two builds of this header).
 struct PixelBuffers {
     uint32_t *key;
     uint32_t *id;

@@ -104,7 +104,6 @@ void resolveFromCache(FragmentCache &cache, const uint32_t *source, size_t width
                       double *depth) {
     const Stopwatch t0;
     FragmentCache::SubmittedDraw &sub = cache.submitted;
-    sub.fragments = sub.passes = sub.covered = 0;
     sub.differs.clear();
     thread_local std::vector<uint32_t> bandIds;  // the submitted ids of the band: pixel - p0
     bandIds.assign(kFragmentBandRows * width, 0);

@@ -111,10 +111,6 @@ void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_
         bandDone(b * bandPixels, size_t(p1));
     }
 }
-template <class Fn>
-void forEachCachedFragmentByBand(const FragmentCache &cache, size_t width, size_t height, Fn &&fn) {
-    forEachCachedFragmentByBand(cache, width, height, fn, [](size_t, size_t) {});
-}
 
 struct ReferenceVisibility {
     int width = 0, height = 0;
