@@ -803,18 +803,16 @@ __attribute__((target("avx2"))) size_t sweepHitsAvx2(const SweepBoxes &b, size_t
     return sweepHits(b, i, j, end, hit, k);
 }
 
-// Calls f(a, b) once for every pair of boxes that intersect as closed boxes (bx0..bx1 x by0..by1 x
-// zmin..zmax; touching counts), in no particular order.
+// Calls f(i, j) once for every pair of boxes that intersect as closed boxes (bx0..bx1 x by0..by1 x
+// zmin..zmax; touching counts), in no particular order. `tris` ascends in zmin, so the boxes a box
+// meets lie just after it in the array (a pair's two triangles are read from nearby memory).
 template <class F>
 void forEachIntersectingBox(const std::vector<PairTri> &tris, F &&f) {
     const size_t n = tris.size();
-    std::vector<uint32_t> byZ(n);
-    std::iota(byZ.begin(), byZ.end(), 0u);
-    std::sort(byZ.begin(), byZ.end(), [&](uint32_t a, uint32_t b) { return tris[a].zmin < tris[b].zmin; });
     SweepBoxes b;
     for (std::vector<double> *side : {&b.z0, &b.z1, &b.x0, &b.x1, &b.y0, &b.y1}) side->resize(n);
     for (size_t i = 0; i < n; ++i) {
-        const PairTri &t = tris[byZ[i]];
+        const PairTri &t = tris[i];
         b.z0[i] = t.zmin, b.z1[i] = t.zmax, b.x0[i] = t.bx0, b.x1[i] = t.bx1, b.y0[i] = t.by0, b.y1[i] = t.by1;
     }
     const bool avx2 = __builtin_cpu_supports("avx2");
@@ -823,7 +821,7 @@ void forEachIntersectingBox(const std::vector<PairTri> &tris, F &&f) {
         // z0 ascends: the boxes after i starting at or below its top end at `end`.
         const size_t end = size_t(std::upper_bound(b.z0.begin() + ptrdiff_t(i) + 1, b.z0.end(), b.z1[i]) - b.z0.begin());
         const size_t k = avx2 ? sweepHitsAvx2(b, i, end, hit.data()) : sweepHits(b, i, i + 1, end, hit.data(), 0);
-        for (size_t m = 0; m < k; ++m) f(tris[byZ[i]], tris[byZ[hit[m]]]);
+        for (size_t m = 0; m < k; ++m) f(i, size_t(hit[m]));
     }
 }
 
@@ -879,14 +877,15 @@ OverlapTests painterOverlapTests(const OrderingView &v, const std::vector<uint32
             }
         tris.push_back(p);
     }
+    // In ascending zmin for the sweep below (the counts do not depend on the order).
+    std::sort(tris.begin(), tris.end(), [](const PairTri &a, const PairTri &b) { return a.zmin < b.zmin; });
     const size_t n = tris.size();
     r.trianglesTested = n;
 
     // Pairs whose closed depth ranges overlap: all pairs minus those with a entirely nearer than b
-    // (a.zmax < b.zmin), counted with a binary search over the sorted zmin.
+    // (a.zmax < b.zmin), counted with a binary search over the zmin (ascending, as tris).
     std::vector<double> zmins(n);
     for (size_t i = 0; i < n; ++i) zmins[i] = tris[i].zmin;
-    std::sort(zmins.begin(), zmins.end());
     uint64_t disjoint = 0;
     for (const PairTri &t : tris) disjoint += uint64_t(zmins.end() - std::upper_bound(zmins.begin(), zmins.end(), t.zmax));
     r.pairs = uint64_t(n) * (n - (n > 0)) / 2 - disjoint;
@@ -899,12 +898,13 @@ OverlapTests painterOverlapTests(const OrderingView &v, const std::vector<uint32
     std::vector<int8_t> eyeSideOf(scene.triangleCount(), 0);
     for (const PairTri &t : tris) eyeSideOf[t.src] = int8_t(eyeSide(scene, v.cam, t.src));
     uint64_t boundsOverlap = 0;
-    auto classify = [&](const PairTri &A, const PairTri &B) {
+    auto classify = [&](size_t a, size_t b) {
         ++boundsOverlap;
-        const PairTri &Pt = A.rank < B.rank ? A : B;  // drawn first: the farther by the sort
-        const PairTri &Qt = A.rank < B.rank ? B : A;
+        const size_t p = tris[a].rank < tris[b].rank ? a : b;  // drawn first: the farther by the sort
+        const size_t q = p == a ? b : a;
+        const PairTri &Pt = tris[p], &Qt = tris[q];
         const uint32_t P = Pt.src, Q = Qt.src;
-        const PlaneSide &planeP = planeOf[size_t(&Pt - tris.data())], &planeQ = planeOf[size_t(&Qt - tris.data())];
+        const PlaneSide &planeP = planeOf[p], &planeQ = planeOf[q];
         const int eyeQ = eyeSideOf[Q], eyeP = eyeSideOf[P];
         if (allOnSide(planeQ, Pt, -eyeQ)) {
             ++r.behindPlane;
