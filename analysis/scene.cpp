@@ -129,7 +129,7 @@ void boundingSphere(const Scene &s, SceneObject &so) {
 
 // ---- The backface stage's float filter ------------------------------------------------------------
 // The backface stage (analysis/stages/backface.cpp) decides most triangles with the plane rounded to
-// float, read in objectTriangles order (sequential, 24 bytes a triangle instead of a gather of 48).
+// float, read in objectTriangles order (sequential, 16 bytes a triangle instead of a gather of 48).
 // The bound, pbrt-style, with u = 2^-24 (float's unit roundoff), the double plane (n, k), A = |n|_1,
 // V = the largest |coordinate| of the triangle's vertices, M = maxAbs(eye) and D the exact
 // orientation value at the eye, whose sign is the answer:
@@ -138,33 +138,42 @@ void boundingSphere(const Scene &s, SceneObject &so) {
 //     |n'.e' + k' - (n.e + k)| <= u|n|.|e'| + u|n|.|e| + u|k| <= (2u + u^2) A M + u|k|;
 //   - s' = ((n'x e'x + n'y e'y) + n'z e'z) + k' in float: |s' - (n'.e' + k')| <= gamma_f(4)
 //     (|n'|.|e'| + |k'|) <= gamma_f(4) (1 + u)^2 (A M + |k|);
-//   so |s' - D| <= 8u (A M + |k|) + gamma(12) A (M + V) = a M + b with a = (8u + gamma(12)) A and
-//   b = 8u |k| + gamma(12) A V. Both are stored doubled and rounded up to float, which covers
-//   evaluating a M + b in float with M rounded up (a relative error of a few u). The stage decides
-//   front when s' > a M + b, back when s' < -(a M + b), and leaves every other triangle -- NaN and
-//   overflow to infinity included, where no comparison holds -- to the double test.
+//   so |s' - D| <= 8u (A M + |k|) + gamma(12) A (M + V) = A ((8u + gamma(12)) M + gamma(12) V) + 8u |k|.
+// The stage has n' and k', not A and |k|: A <= A' (1 + 4u) with A' = (|n'x| + |n'y|) + |n'z| summed
+// in float (each |n'| within u of |n|, two roundings of the sum), |k| <= |k'| (1 + 2u); and V is
+// bounded by the largest V of the triangle's culling object (objectV, rounded up). So
+//   |s' - D| <= A' P + |k'| K,  P = (1 + 4u) ((8u + gamma(12)) M + gamma(12) V_object),  K = 8u (1 + 2u),
+// both doubled and rounded up to float (BackfacePlanes::bound), which covers evaluating A' P +
+// |k'| K in float (three roundings, a relative error of a few u) with M rounded up. The stage
+// decides front when s' > that bound, back when s' < -bound, and leaves every other triangle -- NaN
+// and overflow to infinity included, where no comparison holds -- to the double test.
 static float roundUpToFloat(double x) {
     const float f = float(x);
     return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
-// The filter's entry for a plane (4 doubles n.x n.y n.z k), A = |n|_1 and V = the largest
-// |coordinate| of its vertices.
-static Scene::BackfacePlane backfacePlaneOf(const double *plane, double A, double V) {
+Scene::BackfaceBound Scene::BackfacePlanes::bound(uint32_t object, double eyeMax) const {
     constexpr double u = 0x1p-24;
-    const double k = plane[3];
-    return {float(plane[0]), float(plane[1]), float(plane[2]), float(k),
-            roundUpToFloat(2 * (8 * u + gamma(12)) * A), roundUpToFloat(2 * (8 * u * std::fabs(k) + gamma(12) * A * V))};
+    const double M = double(roundUpToFloat(eyeMax)), V = double(objectV[object]);
+    return {roundUpToFloat(2 * (1 + 4 * u) * ((8 * u + gamma(12)) * M + gamma(12) * V)),
+            roundUpToFloat(2 * 8 * u * (1 + 2 * u))};
 }
 
-// Per objectTriangles entry, the plane rounded to float and the two terms of its error bound.
+// Per objectTriangles entry, the plane rounded to float; per culling object, the largest |coordinate|
+// of its triangles' vertices (planeBounds), rounded up.
 static void buildBackfacePlanes(Scene &s) {
-    s.backfacePlanes.resize(s.objectTriangles.size());
+    Scene::BackfacePlanes &q = s.backfacePlanes;
+    q.resize(s.objectTriangles.size());
     for (size_t i = 0; i < s.objectTriangles.size(); ++i) {
-        const uint32_t t = s.objectTriangles[i];
-        const double *p = &s.planes[4 * size_t(t)];
-        const double A = s.planeBounds[2 * size_t(t)], V = s.planeBounds[2 * size_t(t) + 1];
-        s.backfacePlanes.set(i, backfacePlaneOf(p, A, V));
+        const double *p = &s.planes[4 * size_t(s.objectTriangles[i])];
+        q.set(i, {float(p[0]), float(p[1]), float(p[2]), float(p[3])});
+    }
+    q.objectV.assign(s.objects.size(), 0.0f);
+    for (size_t o = 0; o < s.objects.size(); ++o) {
+        double V = 0;
+        for (uint32_t i = s.objects[o].triBegin; i < s.objects[o].triEnd; ++i)
+            V = std::max(V, s.planeBounds[2 * size_t(s.objectTriangles[i]) + 1]);
+        q.objectV[o] = roundUpToFloat(V);
     }
 }
 

@@ -1,6 +1,7 @@
 // The scene model (docs/architecture.md, Scene model). Owned by analysis/; render/ never sees it.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -287,22 +288,34 @@ struct Scene {
                                           //   largest |coordinate| of its vertices (the backface
                                           //   test's rounding bound, isFrontFacing); 0 when excluded
     // The backface stage's streaming filter, one per Scene::objectTriangles entry (in that order,
-    // so the stage reads it front to back): the plane rounded to float and a bound on the error of
-    // evaluating it in float at an eye e (scene.cpp derives it). Empty: the stage uses only the
-    // double test.
+    // so the stage reads it front to back): the plane rounded to float, 16 bytes a triangle; and per
+    // culling object the largest |coordinate| of its triangles' vertices. With them a bound on the
+    // error of evaluating a plane in float at an eye e (scene.cpp derives it). Empty: the stage uses
+    // only the double test.
     struct BackfacePlane {
         float nx, ny, nz, k;  // the plane, each coordinate rounded to float
-        float a, b;           // |s_float(e) - side| <= a * maxAbs(e) + b, rounded up
     };
-    // Stored as six float arrays (structure of arrays: the stage's loop runs four or eight
+    // The bound's two factors for one object at one eye: |s_float(e) - side| <= (|nx| + |ny| + |nz|)
+    // * perNormal + |k| * perOffset, each product and the sum in float (scene.cpp).
+    struct BackfaceBound {
+        float perNormal, perOffset;
+    };
+    // Stored as four float arrays (structure of arrays: the stage's loop runs four or eight
     // triangles per instruction); operator[] reads one entry.
     struct BackfacePlanes {
-        std::vector<float> nx, ny, nz, k, a, b;
+        std::vector<float> nx, ny, nz, k;
+        std::vector<float> objectV;  // per culling object, rounded up
         size_t size() const { return nx.size(); }
-        void resize(size_t n) { nx.resize(n), ny.resize(n), nz.resize(n), k.resize(n), a.resize(n), b.resize(n); }
-        void set(size_t i, const BackfacePlane &p) { nx[i] = p.nx, ny[i] = p.ny, nz[i] = p.nz, k[i] = p.k, a[i] = p.a, b[i] = p.b; }
-        BackfacePlane operator[](size_t i) const { return {nx[i], ny[i], nz[i], k[i], a[i], b[i]}; }
-        uint64_t bytes() const { return 6 * sizeof(float) * nx.capacity(); }
+        void resize(size_t n) { nx.resize(n), ny.resize(n), nz.resize(n), k.resize(n); }
+        void set(size_t i, const BackfacePlane &p) { nx[i] = p.nx, ny[i] = p.ny, nz[i] = p.nz, k[i] = p.k; }
+        BackfacePlane operator[](size_t i) const { return {nx[i], ny[i], nz[i], k[i]}; }
+        // The factors for culling object `object` seen from an eye with maxAbs(e) = eyeMax.
+        BackfaceBound bound(uint32_t object, double eyeMax) const;
+        // The bound of entry i (of that object) at that eye: what the stage compares with.
+        static float boundOf(const BackfacePlane &p, BackfaceBound b) {
+            return ((std::fabs(p.nx) + std::fabs(p.ny)) + std::fabs(p.nz)) * b.perNormal + std::fabs(p.k) * b.perOffset;
+        }
+        uint64_t bytes() const { return 4 * sizeof(float) * nx.capacity() + sizeof(float) * objectV.capacity(); }
     };
     BackfacePlanes backfacePlanes;
     std::vector<SceneObject> objects;

@@ -114,9 +114,9 @@ TEST(Backface, FloatFilterAgreesWithTheExactTestOverWideMagnitudes) {
                     if (isFrontFacing(scene, t, cam, &on)) kept.push_back(t);
                     else edgeOn += on;
                     const Scene::BackfacePlane q = scene.backfacePlanes[i];
-                    const float M = float(maxAbs(eye)) * (1 + 0x1p-20f);
                     const float sf = ((q.nx * float(eye.x) + q.ny * float(eye.y)) + q.nz * float(eye.z)) + q.k;
-                    decidedByFloat += std::fabs(sf) > q.a * M + q.b;
+                    decidedByFloat +=
+                        std::fabs(sf) > Scene::BackfacePlanes::boundOf(q, scene.backfacePlanes.bound(o, maxAbs(eye)));
                     ++tested;
                 }
             EXPECT_EQ(r.kept.triangles, kept) << "scale " << scale << " eye " << eye.x << " " << eye.y << " " << eye.z;

@@ -1,8 +1,13 @@
 #include "analysis/stages/backface.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -32,6 +37,64 @@ inline int filteredSide(const Scene &scene, uint32_t t, Vec3 eye, double eyeMax)
     const double err = gamma(12) * (b[0] * (eyeMax + b[1]));
     return s > err ? 1 : (s < -err ? -1 : 0);
 }
+
+#if defined(__x86_64__) || defined(__i386__)
+// For each 8-bit mask, the positions of its set bits in ascending order, then the rest (a
+// permutation that packs the lanes a mask selects to the front, keeping their order).
+struct PackTable {
+    uint8_t lane[256][8];
+    constexpr PackTable() : lane{} {
+        for (int m = 0; m < 256; ++m) {
+            int k = 0;
+            for (int i = 0; i < 8; ++i)
+                if (m >> i & 1) lane[m][k++] = uint8_t(i);
+            for (int i = 0; i < 8; ++i)
+                if (!(m >> i & 1)) lane[m][k++] = uint8_t(i);
+        }
+    }
+};
+constexpr PackTable kPack;
+
+// The float filter over an object's triangles [0, n8) (n8: n rounded down to 8), eight at a time,
+// with the loop's arithmetic in the same order (so the same verdicts), and the triangles it decides
+// packed into kept and culled in order (8 lanes stored, the count advanced by those taken: both
+// have 8 entries of room past their end). A group with an undecided triangle goes to `one` (the
+// double and exact tests) triangle by triangle with its verdict (+1, -1, 0), in order.
+template <class One>
+__attribute__((target("avx2"))) uint32_t frontOrBackAvx2(const float *qx, const float *qy, const float *qz,
+                                                          const float *qk, Scene::BackfaceBound b, float ex, float ey,
+                                                          float ez, const uint32_t *tris, uint32_t n, uint32_t *kept,
+                                                          size_t &nk, uint32_t *culled, size_t &nc, One &&one) {
+    const __m256 vx = _mm256_set1_ps(ex), vy = _mm256_set1_ps(ey), vz = _mm256_set1_ps(ez);
+    const __m256 pn = _mm256_set1_ps(b.perNormal), pk = _mm256_set1_ps(b.perOffset);
+    const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF)), negZero = _mm256_set1_ps(-0.0f);
+    uint32_t j = 0;
+    for (; j + 8 <= n; j += 8) {
+        const __m256 x = _mm256_loadu_ps(qx + j), y = _mm256_loadu_ps(qy + j), z = _mm256_loadu_ps(qz + j),
+                     k = _mm256_loadu_ps(qk + j);
+        const __m256 sf = _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, vx), _mm256_mul_ps(y, vy)),
+                                                      _mm256_mul_ps(z, vz)),
+                                        k);
+        const __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(x, absMask), _mm256_and_ps(y, absMask)),
+                                         _mm256_and_ps(z, absMask));
+        const __m256 bound = _mm256_add_ps(_mm256_mul_ps(sum, pn), _mm256_mul_ps(_mm256_and_ps(k, absMask), pk));
+        const unsigned front = unsigned(_mm256_movemask_ps(_mm256_cmp_ps(sf, bound, _CMP_GT_OQ)));
+        const unsigned back = unsigned(_mm256_movemask_ps(_mm256_cmp_ps(sf, _mm256_xor_ps(bound, negZero), _CMP_LT_OQ)));
+        if ((front | back) != 0xFF) [[unlikely]] {
+            for (int i = 0; i < 8; ++i) one(j + uint32_t(i), int(front >> i & 1) - int(back >> i & 1));
+            continue;
+        }
+        const __m256i t = _mm256_loadu_si256(reinterpret_cast<const __m256i *>(tris + j));
+        const __m256i toFront = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i *>(kPack.lane[front])));
+        const __m256i toBack = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i *>(kPack.lane[back])));
+        _mm256_storeu_si256(reinterpret_cast<__m256i *>(kept + nk), _mm256_permutevar8x32_epi32(t, toFront));
+        _mm256_storeu_si256(reinterpret_cast<__m256i *>(culled + nc), _mm256_permutevar8x32_epi32(t, toBack));
+        nk += unsigned(std::popcount(front));
+        nc += unsigned(std::popcount(back));
+    }
+    return j;
+}
+#endif
 }  // namespace
 
 bool isFrontFacing(const Scene &scene, uint32_t t, const Camera &cam, bool *edgeOn) {
@@ -96,14 +159,14 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
     // The float filter (scene.cpp, "The backface stage's float filter") decides a triangle from its
     // plane in float, read in object order; what it cannot decide goes to the double filter and the
     // exact test. Outputs are written branch-free into room for every triangle, then trimmed.
-    const bool floatFilter = !cam.orthographic && scene.backfacePlanes.size() == scene.objectTriangles.size();
+    const bool floatFilter = !cam.orthographic && scene.backfacePlanes.size() == scene.objectTriangles.size() &&
+                             scene.backfacePlanes.objectV.size() == scene.objects.size();
     const float ex = float(cam.eye.x), ey = float(cam.eye.y), ez = float(cam.eye.z);
-    const float M = [&] {
-        const float f = float(eyeMax);
-        return double(f) < eyeMax ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-    }();
-    l.triangles.resize(total);
-    r.culled.resize(total);
+    l.triangles.resize(total + 8);  // 8 past the end: frontOrBackAvx2 stores eight lanes at a time
+    r.culled.resize(total + 8);
+#if defined(__x86_64__) || defined(__i386__)
+    const bool avx2 = floatFilter && __builtin_cpu_supports("avx2");
+#endif
     uint32_t *kept = l.triangles.data(), *culled = r.culled.data();
     size_t nk = 0, nc = 0;
     for (uint32_t o : objects) {
@@ -117,36 +180,48 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
             nk += n;
         } else {
             st.trianglesTested += n;
-            // Pass 1 (vectorizable): the float filter's verdict per triangle, +1 front, -1 back, 0
-            // undecided. Pass 2: the undecided ones by the double and exact tests, and the output.
-            thread_local std::vector<int8_t> sides;
-            sides.resize(n);
-            int8_t *side = sides.data();
-            if (floatFilter) {
-                const Scene::BackfacePlanes &q = scene.backfacePlanes;
-                const float *qx = q.nx.data() + ob.triBegin, *qy = q.ny.data() + ob.triBegin,
-                            *qz = q.nz.data() + ob.triBegin, *qk = q.k.data() + ob.triBegin,
-                            *qa = q.a.data() + ob.triBegin, *qb = q.b.data() + ob.triBegin;
-                for (uint32_t j = 0; j < n; ++j) {
-                    const float sf = ((qx[j] * ex + qy[j] * ey) + qz[j] * ez) + qk[j];
-                    const float bound = qa[j] * M + qb[j];
-                    side[j] = int8_t((sf > bound) - (sf < -bound));
-                }
-            } else {
-                std::fill(side, side + n, int8_t(0));
-            }
-            for (uint32_t j = 0; j < n; ++j) {
+            // One triangle with the float filter's verdict sd (+1 front, -1 back, 0 undecided): the
+            // undecided by isFrontFacing's double filter, then the exact test where that cannot
+            // decide; then the output, branch-free.
+            auto one = [&](uint32_t j, int sd) {
                 const uint32_t t = tris[j];
-                int sd = side[j];
                 bool edgeOn = false;
-                // Undecided: isFrontFacing's double filter, then the exact test where that cannot decide.
                 if (sd == 0) sd = isFrontFacing(scene, t, cam, &edgeOn) ? 1 : -1;
                 kept[nk] = t;
                 culled[nc] = t;
                 nk += sd > 0;
                 nc += sd < 0;
                 st.edgeOn += edgeOn && sd < 0;  // an edge-on triangle kept (orthographic) is not counted
+            };
+            uint32_t from = 0;
+#if defined(__x86_64__) || defined(__i386__)
+            if (avx2) {
+                const Scene::BackfacePlanes &q = scene.backfacePlanes;
+                from = frontOrBackAvx2(q.nx.data() + ob.triBegin, q.ny.data() + ob.triBegin, q.nz.data() + ob.triBegin,
+                                       q.k.data() + ob.triBegin, q.bound(o, eyeMax), ex, ey, ez, tris, n, kept, nk,
+                                       culled, nc, one);
             }
+#endif
+            // The rest: pass 1 (vectorizable), the float filter's verdict per triangle; pass 2, one().
+            thread_local std::vector<int8_t> sides;
+            sides.resize(n);
+            int8_t *side = sides.data();
+            if (floatFilter) {
+                const Scene::BackfacePlanes &q = scene.backfacePlanes;
+                const float *qx = q.nx.data() + ob.triBegin, *qy = q.ny.data() + ob.triBegin,
+                            *qz = q.nz.data() + ob.triBegin, *qk = q.k.data() + ob.triBegin;
+                const Scene::BackfaceBound b = q.bound(o, eyeMax);
+                for (uint32_t j = from; j < n; ++j) {
+                    const float sf = ((qx[j] * ex + qy[j] * ey) + qz[j] * ez) + qk[j];
+                    // Scene::BackfacePlanes::boundOf, inline in this loop's vector form.
+                    const float bound = ((std::fabs(qx[j]) + std::fabs(qy[j])) + std::fabs(qz[j])) * b.perNormal +
+                                        std::fabs(qk[j]) * b.perOffset;
+                    side[j] = int8_t((sf > bound) - (sf < -bound));
+                }
+            } else {
+                std::fill(side + from, side + n, int8_t(0));
+            }
+            for (uint32_t j = from; j < n; ++j) one(j, side[j]);
         }
         if (nk > begin) {  // objects with every triangle culled leave no group
             l.objects.push_back(o);
