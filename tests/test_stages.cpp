@@ -105,14 +105,14 @@ TEST(Backface, FloatFilterAgreesWithTheExactTestOverWideMagnitudes) {
             std::string err;
             ASSERT_TRUE(makeCamera(spec, &cam, &err)) << err;
             const BackfaceResult r = cullBackfaces(scene, objects, cam);
-            std::vector<uint32_t> kept;
+            std::vector<uint32_t> kept, culled;
             uint64_t edgeOn = 0;
             for (uint32_t o : objects)
                 for (uint32_t i = scene.objects[o].triBegin; i < scene.objects[o].triEnd; ++i) {
                     const uint32_t t = scene.objectTriangles[i];
                     bool on = false;
                     if (isFrontFacing(scene, t, cam, &on)) kept.push_back(t);
-                    else edgeOn += on;
+                    else edgeOn += on, culled.push_back(t);
                     const Scene::BackfacePlane q = scene.backfacePlanes[i];
                     const float sf = ((q.nx * float(eye.x) + q.ny * float(eye.y)) + q.nz * float(eye.z)) + q.k;
                     decidedByFloat +=
@@ -120,6 +120,7 @@ TEST(Backface, FloatFilterAgreesWithTheExactTestOverWideMagnitudes) {
                     ++tested;
                 }
             EXPECT_EQ(r.kept.triangles, kept) << "scale " << scale << " eye " << eye.x << " " << eye.y << " " << eye.z;
+            EXPECT_EQ(r.culled, culled);  // in order too (the eight-wide path packs both lists)
             EXPECT_EQ(r.stats.edgeOn, edgeOn);
             EXPECT_EQ(r.stats.trianglesCulled + kept.size(), scene.objectTriangles.size());
         }
