@@ -883,11 +883,11 @@ OverlapTests painterOverlapTests(const OrderingView &v, const std::vector<uint32
     r.trianglesTested = n;
 
     // Pairs whose closed depth ranges overlap: all pairs minus those with a entirely nearer than b
-    // (a.zmax < b.zmin), counted with a binary search over the zmin (ascending, as tris).
-    std::vector<double> zmins(n);
-    for (size_t i = 0; i < n; ++i) zmins[i] = tris[i].zmin;
+    // (a.zmax < b.zmin), counted with a binary search over tris' zmin (ascending).
     uint64_t disjoint = 0;
-    for (const PairTri &t : tris) disjoint += uint64_t(zmins.end() - std::upper_bound(zmins.begin(), zmins.end(), t.zmax));
+    for (const PairTri &t : tris)
+        disjoint += uint64_t(tris.end() - std::upper_bound(tris.begin(), tris.end(), t.zmax,
+                                                            [](double z, const PairTri &p) { return z < p.zmin; }));
     r.pairs = uint64_t(n) * (n - (n > 0)) / 2 - disjoint;
 
     // Per drawn triangle (as tris), its plane's side test and the eye's side of it, once per

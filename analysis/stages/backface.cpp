@@ -193,35 +193,25 @@ BackfaceResult cullBackfaces(const Scene &scene, const std::vector<uint32_t> &ob
                 nc += sd < 0;
                 st.edgeOn += edgeOn && sd < 0;  // an edge-on triangle kept (orthographic) is not counted
             };
+            const Scene::BackfacePlanes &q = scene.backfacePlanes;
+            const Scene::BackfaceBound b = floatFilter ? q.bound(o, eyeMax) : Scene::BackfaceBound{};
             uint32_t from = 0;
 #if defined(__x86_64__) || defined(__i386__)
-            if (avx2) {
-                const Scene::BackfacePlanes &q = scene.backfacePlanes;
+            if (avx2)
                 from = frontOrBackAvx2(q.nx.data() + ob.triBegin, q.ny.data() + ob.triBegin, q.nz.data() + ob.triBegin,
-                                       q.k.data() + ob.triBegin, q.bound(o, eyeMax), ex, ey, ez, tris, n, kept, nk,
-                                       culled, nc, one);
-            }
+                                       q.k.data() + ob.triBegin, b, ex, ey, ez, tris, n, kept, nk, culled, nc, one);
 #endif
-            // The rest: pass 1 (vectorizable), the float filter's verdict per triangle; pass 2, one().
-            thread_local std::vector<int8_t> sides;
-            sides.resize(n);
-            int8_t *side = sides.data();
-            if (floatFilter) {
-                const Scene::BackfacePlanes &q = scene.backfacePlanes;
-                const float *qx = q.nx.data() + ob.triBegin, *qy = q.ny.data() + ob.triBegin,
-                            *qz = q.nz.data() + ob.triBegin, *qk = q.k.data() + ob.triBegin;
-                const Scene::BackfaceBound b = q.bound(o, eyeMax);
-                for (uint32_t j = from; j < n; ++j) {
-                    const float sf = ((qx[j] * ex + qy[j] * ey) + qz[j] * ez) + qk[j];
-                    // Scene::BackfacePlanes::boundOf, inline in this loop's vector form.
-                    const float bound = ((std::fabs(qx[j]) + std::fabs(qy[j])) + std::fabs(qz[j])) * b.perNormal +
-                                        std::fabs(qk[j]) * b.perOffset;
-                    side[j] = int8_t((sf > bound) - (sf < -bound));
+            // The rest (all of them without AVX2) one at a time, with the same float arithmetic.
+            for (uint32_t j = from; j < n; ++j) {
+                int sd = 0;
+                if (floatFilter) {
+                    const Scene::BackfacePlane p = q[ob.triBegin + j];
+                    const float sf = ((p.nx * ex + p.ny * ey) + p.nz * ez) + p.k;
+                    const float bound = Scene::BackfacePlanes::boundOf(p, b);
+                    sd = (sf > bound) - (sf < -bound);
                 }
-            } else {
-                std::fill(side + from, side + n, int8_t(0));
+                one(j, sd);
             }
-            for (uint32_t j = from; j < n; ++j) one(j, side[j]);
         }
         if (nk > begin) {  // objects with every triangle culled leave no group
             l.objects.push_back(o);
